@@ -1,0 +1,9 @@
+#pragma once
+// Entry points of the `mocap` subcommands; each lives in its own file (<name>_command.cpp) and
+// receives the arguments after its own name.
+
+namespace mocap::cli {
+
+int db_command(int argc, char** argv);
+
+}  // namespace mocap::cli

@@ -1,0 +1,59 @@
+// `mocap`: the command line of the motion-capture tool.
+
+#include <exception>
+#include <iostream>
+#include <string_view>
+
+#include "commands.hpp"
+
+namespace {
+
+struct Command {
+  std::string_view name;
+  std::string_view summary;
+  int (*run)(int argc, char** argv);
+};
+
+constexpr Command kCommands[] = {
+    {"db", "build, inspect and query the 2D-projection pose database", mocap::cli::db_command},
+};
+
+void print_usage(std::ostream& out) {
+  out << "usage: mocap COMMAND [ARGS...]\n\n"
+         "Markerless motion capture: video or 2D keypoints in, 3D motion of every person out.\n\n"
+         "commands:\n";
+  for (const auto& c : kCommands) {
+    out << "  " << c.name << std::string(12 - c.name.size(), ' ') << c.summary << "\n";
+  }
+  out << "\nRun 'mocap COMMAND --help' for the options of a command.\n";
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 2) {
+    print_usage(std::cerr);
+    return 2;
+  }
+  const std::string_view name = argv[1];
+  if (name == "--help" || name == "-h" || name == "help") {
+    print_usage(std::cout);
+    return 0;
+  }
+  if (name == "--version") {
+    std::cout << "mocap " MOCAP_VERSION "\n";
+    return 0;
+  }
+  for (const auto& c : kCommands) {
+    if (c.name != name) continue;
+    try {
+      return c.run(argc - 2, argv + 2);
+    } catch (const std::exception& e) {
+      std::cerr << "mocap " << name << ": error: " << e.what() << "\n";
+      return 1;
+    }
+  }
+  std::cerr << "mocap: unknown command '" << name << "'\n\n";
+  print_usage(std::cerr);
+  return 2;
+}
