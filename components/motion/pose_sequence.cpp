@@ -36,12 +36,19 @@ glm::vec3 euler_for_order(const glm::quat& q, const Channel order[3]) {
   return {a, b, c};
 }
 
+// Frame times are written with few digits (cgspeed: ".0083333"); 120.0005 fps is meant as 120.
+// Snapping keeps integer resampling ratios exact. Rates like 29.97 are kept as they are.
+double snap_frame_rate(double fps) {
+  const double nearest = std::round(fps);
+  return std::abs(fps - nearest) < 1e-4 * fps ? nearest : fps;
+}
+
 }  // namespace
 
 PoseSequence to_poses(const Clip& clip) {
   PoseSequence out;
   out.skeleton = clip.skeleton;
-  out.fps = clip.fps();
+  out.fps = snap_frame_rate(clip.fps());
   out.frame_count = clip.frame_count;
   const int joints = clip.skeleton.joint_count();
   out.translation.resize(static_cast<size_t>(clip.frame_count) * joints);

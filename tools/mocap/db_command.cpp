@@ -1,0 +1,328 @@
+// `mocap db build | info | query`: the 2D-projection pose database.
+
+#include <cmath>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <map>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "cli_args.hpp"
+#include "commands.hpp"
+#include "core/input_error.hpp"
+#include "core/keypoint_layout.hpp"
+#include "posedb/builder.hpp"
+#include "posedb/cluster_search.hpp"
+#include "posedb/database.hpp"
+#include "posedb/exact_search.hpp"
+#include "progress_bar.hpp"
+
+namespace mocap::cli {
+namespace {
+
+using nlohmann::json;
+
+std::vector<float> parse_float_list(const std::string& text, const std::string& option) {
+  std::vector<float> out;
+  std::stringstream in(text);
+  for (std::string item; std::getline(in, item, ',');) {
+    try {
+      size_t used = 0;
+      out.push_back(std::stof(item, &used));
+      if (used != item.size()) throw std::invalid_argument(item);
+    } catch (const std::exception&) {
+      throw InputError("--" + option, "expected comma-separated numbers, got '" + text + "'");
+    }
+  }
+  return out;
+}
+
+std::string joined_command(const char* name, int argc, char** argv) {
+  std::string s = std::string("mocap db ") + name;
+  for (int i = 0; i < argc; ++i) s += std::string(" ") + argv[i];
+  return s;
+}
+
+// Keeps the files that a folder's splits.txt ("train 01_01.bvh" lines) assigns to `split`.
+std::vector<std::string> filter_split(const std::vector<std::string>& inputs, const std::vector<std::string>& files,
+                                      const std::string& split) {
+  std::map<std::string, std::string> split_of;
+  for (const auto& in : inputs) {
+    std::ifstream list(std::filesystem::path(in) / "splits.txt");
+    std::string which, file;
+    while (list >> which >> file) split_of[file] = which;
+  }
+  if (split_of.empty()) throw InputError("--split", "no splits.txt found in the input folders");
+  std::vector<std::string> kept;
+  for (const auto& f : files) {
+    const auto it = split_of.find(std::filesystem::path(f).filename().string());
+    if (it != split_of.end() && it->second == split) kept.push_back(f);
+  }
+  if (kept.empty()) throw InputError("--split", "no file belongs to split '" + split + "'");
+  return kept;
+}
+
+int build(int argc, char** argv) {
+  Args args("mocap db build PATH... --out FILE [options]",
+            "Builds the pose database from mocap files (BVH, or ASF/AMC) and folders of them: every frame is\n"
+            "resampled, mapped to the 15-joint body and projected through virtual cameras at several yaws\n"
+            "and heights; the normalised projections are clustered for fast search.");
+  args.positional("PATH", "BVH/AMC files or folders (searched recursively)", true)
+      .option("out", "FILE", "database file to write")
+      .option("fps", "N", "frame rate of the database", "24")
+      .option("yaw-steps", "N", "camera yaw steps around the person (30 = every 12 degrees)", "30")
+      .option("heights", "LIST", "camera heights in metres, comma-separated", "1.5,2.5,4,6")
+      .option("distance", "M", "horizontal camera distance in metres", "4")
+      .option("scaling", "MODE", "2D normalisation: bbox_height (paper) or bone_length", "bbox_height")
+      .option("clusters", "N", "k-means clusters (0 = about sqrt(projections))", "0")
+      .option("seed", "N", "random seed for k-means", "1")
+      .option("threads", "N", "worker threads", "2")
+      .option("split", "NAME", "only files a folder's splits.txt assigns to NAME (e.g. train)");
+  int code = 0;
+  if (!args.parse(argc, argv, code)) return code;
+  if (!args.has("out")) throw InputError("--out", "required: the database file to write");
+
+  posedb::BuildOptions options;
+  options.fps = args.number("fps");
+  options.views.yaw_steps = static_cast<int>(args.integer("yaw-steps"));
+  options.views.heights_m = parse_float_list(args.get("heights"), "heights");
+  options.views.distance_m = static_cast<float>(args.number("distance"));
+  if (!posedb::parse_scaling(args.get("scaling"), options.scaling)) {
+    throw InputError("--scaling", "expected bbox_height or bone_length, got '" + args.get("scaling") + "'");
+  }
+  options.clusters = static_cast<int>(args.integer("clusters"));
+  options.seed = static_cast<std::uint64_t>(args.integer("seed"));
+  options.threads = static_cast<int>(std::clamp(args.integer("threads"), 1L, 64L));
+  options.command = joined_command("build", argc, argv);
+
+  std::vector<std::string> files = posedb::collect_motion_files(args.positionals());
+  if (args.has("split")) files = filter_split(args.positionals(), files, args.get("split"));
+  if (files.empty()) throw InputError("", "no .bvh or .amc files in the given paths");
+  std::cerr << "building from " << files.size() << " motion file(s)\n";
+
+  posedb::BuildReport report;
+  ProgressBar bar;
+  posedb::DatabaseContents db = posedb::build_database(
+      files, options, [&](std::string_view stage, double f) { bar.update(stage, f); }, report);
+  bar.update("write", 0.0);
+  posedb::write_database(db, args.get("out"));
+  bar.finish();
+  for (const auto& s : report.skipped) std::cerr << "skipped: " << s << "\n";
+  std::cout << "wrote " << args.get("out") << ": " << db.clips.size() << " clips, " << db.frames.size()
+            << " frames, " << db.views.size() << " views, " << db.projection_records.size() << " projections, "
+            << db.cluster_begin.size() - 1 << " clusters in " << std::fixed << std::setprecision(1)
+            << db.build.build_seconds << " s";
+  if (!report.skipped.empty()) std::cout << " (" << report.skipped.size() << " file(s) skipped)";
+  std::cout << "\n";
+  return report.skipped.empty() ? 0 : 3;
+}
+
+json info_json(const posedb::Database& db) {
+  std::map<std::string, std::pair<int, std::uint64_t>> families;
+  json clips = json::array();
+  for (const auto& c : db.clips()) {
+    auto& [count, frames] = families[c.family];
+    ++count;
+    frames += c.frame_count;
+    clips.push_back({{"name", c.name}, {"family", c.family}, {"frames", c.frame_count}, {"source_fps", c.source_fps}});
+  }
+  json fam = json::object();
+  for (const auto& [name, cf] : families) fam[name] = {{"clips", cf.first}, {"frames", cf.second}};
+  const auto cb = db.cluster_begin();
+  std::uint32_t largest = 0;
+  for (size_t c = 1; c < cb.size(); ++c) largest = std::max(largest, cb[c] - cb[c - 1]);
+  return {{"file", db.path()},
+          {"bytes", db.file_size()},
+          {"clips", db.clips().size()},
+          {"frames", db.frames().size()},
+          {"views", db.views().size()},
+          {"projections", db.projections().rows},
+          {"dims", db.projections().dim},
+          {"clusters", db.centroids().rows},
+          {"largest_cluster", largest},
+          {"index", "k-means clusters with representatives (rows stored grouped by cluster)"},
+          {"families", fam},
+          {"build", json::parse(db.options_json())},
+          {"clip_list", clips}};
+}
+
+int info(int argc, char** argv) {
+  Args args("mocap db info FILE [--json] [--clips]", "Prints what a pose database holds and how it was built.");
+  args.positional("FILE", "pose database").flag("json", "print JSON").flag("clips", "list every clip");
+  int code = 0;
+  if (!args.parse(argc, argv, code)) return code;
+  const posedb::Database db = posedb::Database::open(args.positionals()[0]);
+  json j = info_json(db);
+  if (args.has("json")) {
+    std::cout << j.dump(2) << "\n";
+    return 0;
+  }
+  const auto& b = db.build_info();
+  std::cout << "file         " << db.path() << " (" << std::fixed << std::setprecision(1)
+            << static_cast<double>(db.file_size()) / 1e6 << " MB)\n"
+            << "clips        " << db.clips().size() << "\n"
+            << "frames       " << db.frames().size() << " at " << b.fps << " fps\n"
+            << "views        " << db.views().size() << " (" << b.views.yaw_steps << " yaws x "
+            << b.views.heights_m.size() << " camera heights";
+  for (float h : b.views.heights_m) std::cout << " " << h;
+  std::cout << " m, " << b.views.distance_m << " m away)\n"
+            << "projections  " << db.projections().rows << " x " << db.projections().dim << " floats, "
+            << posedb::scaling_name(b.scaling) << " normalisation\n"
+            << "clusters     " << db.centroids().rows << " (largest " << j["largest_cluster"] << ")\n"
+            << "index        " << j["index"].get<std::string>() << "\n"
+            << "families    ";
+  for (const auto& [name, f] : j["families"].items()) std::cout << " " << name << ": " << f["clips"] << " clips, " << f["frames"] << " frames;";
+  std::cout << "\nbuilt        " << b.created << " in " << b.build_seconds << " s, seed " << b.seed << "\n"
+            << "command      " << b.command << "\n";
+  if (args.has("clips")) {
+    for (const auto& c : db.clips()) std::cout << "  " << c.name << "  " << c.family << "  " << c.frame_count << " frames\n";
+  }
+  return 0;
+}
+
+// A query pose: {"layout": "COCO-17", "keypoints": [[x, y, c], ...]} (or a flat list), or
+// {"joints": {"head": [x, y], ...}} with the 15 body joint names; absent joints are missing.
+std::array<glm::vec2, kBodyJoints> parse_query_pose(const std::string& text, const std::string& where) {
+  json j;
+  try {
+    j = json::parse(text);
+  } catch (const json::exception& e) {
+    throw InputError(where, std::string("not valid JSON: ") + e.what());
+  }
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  std::array<glm::vec2, kBodyJoints> points;
+  points.fill({nan, nan});
+  try {
+    if (j.contains("joints")) {
+      for (const auto& [name, xy] : j.at("joints").items()) {
+        const auto joint = joint_from_name(name);
+        if (!joint) throw InputError(where, "unknown joint '" + name + "'");
+        points[index(*joint)] = {xy.at(0).get<float>(), xy.at(1).get<float>()};
+      }
+      return points;
+    }
+    const KeypointLayout* layout = find_layout(j.at("layout").get<std::string>());
+    if (!layout) throw InputError(where, "unknown layout '" + j.at("layout").get<std::string>() + "'");
+    std::vector<float> flat;
+    for (const auto& v : j.at("keypoints")) {
+      if (v.is_array()) {
+        for (const auto& x : v) flat.push_back(x.get<float>());
+      } else {
+        flat.push_back(v.get<float>());
+      }
+    }
+    if (flat.size() != layout->keypoints.size() * 3) {
+      throw InputError(where, std::string(layout->name) + " needs " + std::to_string(layout->keypoints.size()) +
+                                  " keypoints of (x, y, confidence), got " + std::to_string(flat.size()) + " numbers");
+    }
+    std::array<float, kBodyJoints * 3> body;
+    to_body15(*layout, flat, body);
+    for (int b = 0; b < kBodyJoints; ++b) points[b] = {body[3 * b], body[3 * b + 1]};
+  } catch (const json::exception& e) {
+    throw InputError(where, std::string("unexpected JSON shape: ") + e.what());
+  }
+  return points;
+}
+
+int query(int argc, char** argv) {
+  Args args("mocap db query FILE (--pose JSON | --pose-file FILE | --self N) [options]",
+            "Finds the k nearest database projections of a 2D pose.\n"
+            "A pose is {\"layout\": \"COCO-17\", \"keypoints\": [[x, y, confidence], ...]} in any layout\n"
+            "(COCO-17, BODY_25, BODY_25B, COCO-18, HumanEva-15), or {\"joints\": {\"head\": [x, y], ...}}\n"
+            "with the 15 body joint names; image coordinates, y down. Missing joints are left out of the distance.");
+  args.positional("FILE", "pose database")
+      .option("pose", "JSON", "the pose, inline")
+      .option("pose-file", "FILE", "the pose, from a file")
+      .option("self", "N", "query with the database's own projection number N")
+      .option("k", "N", "neighbours to return", "10")
+      .option("method", "NAME", "exact or clusters", "clusters")
+      .option("probe", "N", "clusters to scan (method clusters)", "8")
+      .flag("json", "print JSON lines");
+  int code = 0;
+  if (!args.parse(argc, argv, code)) return code;
+  const posedb::Database db = posedb::Database::open(args.positionals()[0]);
+
+  posedb::PoseVector query{};
+  if (args.has("self")) {
+    const long n = args.integer("self");
+    if (n < 0 || static_cast<std::size_t>(n) >= db.projections().rows) {
+      throw InputError("--self", "projection number out of range (0 to " + std::to_string(db.projections().rows - 1) + ")");
+    }
+    std::copy_n(db.projections().row(static_cast<std::size_t>(n)), posedb::kPoseDims, query.begin());
+  } else {
+    std::string text = args.get("pose"), where = "--pose";
+    if (args.has("pose-file")) {
+      where = args.get("pose-file");
+      std::ifstream in(where);
+      if (!in) throw InputError(where, "cannot open");
+      text.assign(std::istreambuf_iterator<char>(in), {});
+    } else if (!args.has("pose")) {
+      throw InputError("", "give the pose with --pose, --pose-file or --self");
+    }
+    const auto points = parse_query_pose(text, where);
+    if (!posedb::normalize_pose(points, db.build_info().scaling, query)) {
+      throw InputError(where, "cannot normalise this pose: the root (mid-hips) and at least 3 joints are needed");
+    }
+  }
+  posedb::PoseVector weights;
+  for (int d = 0; d < posedb::kPoseDims; ++d) weights[d] = std::isfinite(query[d]) ? 1.0f : 0.0f;
+
+  std::unique_ptr<posedb::SearchIndex> index;
+  if (args.get("method") == "exact") {
+    index = std::make_unique<posedb::ExactSearch>(db.projections());
+  } else if (args.get("method") == "clusters") {
+    index = std::make_unique<posedb::ClusterSearch>(db.projections(), db.centroids(), db.cluster_begin(),
+                                                    static_cast<int>(args.integer("probe")));
+  } else {
+    throw InputError("--method", "expected exact or clusters, got '" + args.get("method") + "'");
+  }
+  std::vector<posedb::Neighbor> found;
+  index->search(query.data(), weights.data(), static_cast<int>(std::clamp(args.integer("k"), 1L, 10000L)), found);
+  for (size_t r = 0; r < found.size(); ++r) {
+    const auto& rec = db.projection_records()[found[r].index];
+    const auto& frame = db.frames()[rec.frame];
+    const auto& clip = db.clips()[frame.clip];
+    const auto& view = db.views()[rec.view];
+    if (args.has("json")) {
+      std::cout << json{{"rank", r}, {"projection", found[r].index}, {"distance", found[r].distance},
+                        {"clip", clip.name}, {"clip_frame", frame.clip_frame}, {"frame", rec.frame},
+                        {"yaw_deg", view.yaw_deg}, {"camera_height_m", view.height_m}}
+                       .dump()
+                << "\n";
+    } else {
+      std::cout << std::setw(3) << r << "  distance " << std::setw(10) << std::setprecision(6) << found[r].distance
+                << "  projection " << std::setw(8) << found[r].index << "  " << clip.name << " frame "
+                << frame.clip_frame << "  yaw " << view.yaw_deg << "  camera " << view.height_m << " m\n";
+    }
+  }
+  return 0;
+}
+
+}  // namespace
+
+int db_command(int argc, char** argv) {
+  const std::string usage =
+      "usage: mocap db build|info|query ...\n\n"
+      "  build   build a pose database from mocap files\n"
+      "  info    print what a database holds\n"
+      "  query   find the nearest projections of a 2D pose\n\n"
+      "Run 'mocap db SUBCOMMAND --help' for options.\n";
+  if (argc < 1) {
+    std::cerr << usage;
+    return 2;
+  }
+  const std::string sub = argv[0];
+  if (sub == "build") return build(argc - 1, argv + 1);
+  if (sub == "info") return info(argc - 1, argv + 1);
+  if (sub == "query") return query(argc - 1, argv + 1);
+  if (sub == "--help" || sub == "-h") {
+    std::cout << usage;
+    return 0;
+  }
+  std::cerr << "mocap db: unknown subcommand '" << sub << "'\n\n" << usage;
+  return 2;
+}
+
+}  // namespace mocap::cli
