@@ -1,0 +1,101 @@
+#pragma once
+// The messages that flow between nodes. Every message starts with a Header; in a process it is
+// shared as std::shared_ptr<const T> (immutable once sent, so fan-out costs nothing), between
+// processes it travels in the wire format described in docs/wire-format.md.
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <glm/gtc/quaternion.hpp>
+#include <glm/vec3.hpp>
+
+#include "core/body15.hpp"
+#include "core/image_buffer.hpp"
+#include "core/keypoint_layout.hpp"
+
+namespace mocap {
+
+struct Header {
+  std::string stream;           // which stream (camera, file) the message belongs to
+  std::uint64_t seq = 0;        // counts the messages of one stream from 0
+  std::int64_t capture_ns = 0;  // when the source captured it (CLOCK_REALTIME), never a later time
+  std::int64_t frame = 0;       // frame index in the source
+
+  bool operator==(const Header&) const = default;
+};
+
+// Base of every message type; each derived type names itself with kTypeName, the string used by
+// port declarations, graph validation and the wire format.
+struct Message {
+  Header header;
+};
+
+struct VideoFrame : Message {
+  static constexpr std::string_view kTypeName = "VideoFrame";
+  int camera_id = 0;
+  ImageBuffer image;
+};
+
+struct Keypoint2D {
+  float x = 0, y = 0;
+  float confidence = 0;  // NaN coordinates or confidence 0: the keypoint is missing
+};
+
+struct Box2D {
+  float x = 0, y = 0, width = 0, height = 0;
+};
+
+struct Person2D {
+  int id = -1;                     // -1 until a tracker assigns one
+  std::vector<Keypoint2D> joints;  // in the order of the message's layout
+  Box2D box;
+};
+
+struct People2D : Message {
+  static constexpr std::string_view kTypeName = "People2D";
+  LayoutId layout = LayoutId::coco17;
+  std::vector<Person2D> people;
+};
+
+struct RigidTransform {
+  glm::quat rotation{1.0f, 0.0f, 0.0f, 0.0f};  // w, x, y, z
+  glm::vec3 translation{0.0f};
+};
+
+// Where a 3D pose came from, for debugging the matcher: database clip, frame and view.
+struct Provenance {
+  std::string clip;
+  std::int64_t frame = -1;
+  int view = -1;
+};
+
+inline std::array<glm::quat, kBodyJoints> identity_rotations() {
+  std::array<glm::quat, kBodyJoints> rotations;
+  rotations.fill(glm::quat(1.0f, 0.0f, 0.0f, 0.0f));
+  return rotations;
+}
+
+struct Person3D {
+  int id = -1;
+  // Metres, camera coordinates (x right, y down, z forward), indexed by mocap::Joint.
+  std::array<glm::vec3, kBodyJoints> positions{};
+  std::array<glm::quat, kBodyJoints> rotations = identity_rotations();  // local joint rotations
+  RigidTransform root;
+  Provenance provenance;
+};
+
+struct People3D : Message {
+  static constexpr std::string_view kTypeName = "People3D";
+  std::vector<Person3D> people;
+};
+
+// Flows through every edge after a stream's last message; a node closes once all its inputs have
+// ended. Node code never sees it: the framework handles it.
+struct EndOfStream : Message {
+  static constexpr std::string_view kTypeName = "EndOfStream";
+};
+
+}  // namespace mocap

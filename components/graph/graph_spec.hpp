@@ -1,0 +1,93 @@
+#pragma once
+// A graph as written in a graph file, before it is checked against the node types: nodes with
+// their parameters as text, edges with policy and transport, placement into processes. Every
+// item remembers where it was written so errors can name file and line.
+
+#include <cstddef>
+#include <map>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace mocap::graph {
+
+struct SourceLocation {
+  std::string file;
+  int line = 0;  // 1-based; 0 when not from a file (command line)
+
+  std::string str() const { return line > 0 ? file + ":" + std::to_string(line) : file; }
+};
+
+enum class PolicyKind { blocking, latest, drop_oldest };
+
+struct EdgePolicy {
+  PolicyKind kind = PolicyKind::blocking;
+  std::size_t capacity = 16;  // latest: always 1
+
+  std::string str() const;
+  bool lossy() const { return kind != PolicyKind::blocking; }
+};
+
+// "blocking", "blocking(64)", "latest", "drop_oldest", "drop_oldest(4)"; nullopt when malformed.
+std::optional<EdgePolicy> parse_policy(std::string_view text);
+
+struct PortRef {
+  std::string node, port;
+  std::string str() const { return node + "." + port; }
+};
+
+struct EdgeSpec {
+  PortRef from, to;
+  EdgePolicy policy;
+  std::string transport;  // empty: in-process; else a ZeroMQ endpoint (inproc://, ipc://, tcp://)
+  SourceLocation where;
+
+  std::string str() const { return from.str() + " -> " + to.str(); }
+};
+
+struct ParamText {
+  std::string text;
+  SourceLocation where;
+};
+
+struct NodeSpec {
+  std::string name, type;
+  std::map<std::string, ParamText> params;
+  SourceLocation where;
+};
+
+struct ProcessSpec {
+  std::string name;
+  std::vector<std::string> nodes;
+  SourceLocation where;
+};
+
+struct PluginSpec {
+  std::string path;  // resolved against the graph file's directory
+  SourceLocation where;
+};
+
+struct GraphSpec {
+  std::string name;
+  std::string file;
+  std::vector<NodeSpec> nodes;
+  std::vector<EdgeSpec> edges;
+  std::vector<ProcessSpec> processes;
+  std::vector<PluginSpec> plugins;
+  bool allow_network = false;  // tcp:// endpoints beyond loopback need `allow_network: true`
+
+  const NodeSpec* find_node(std::string_view name) const;
+  // The process a node is placed in; empty when the graph has no placement.
+  std::string process_of(std::string_view node) const;
+};
+
+// Reads a graph file. Throws mocap::InputError with file and line on bad YAML or structure.
+GraphSpec load_graph_file(const std::string& path);
+GraphSpec parse_graph_text(const std::string& text, const std::string& file_name);
+
+// Applies `node.param=value` overrides (from --set). Throws InputError for malformed overrides or
+// unknown nodes; unknown parameters are caught by validation like those in the file.
+void apply_overrides(GraphSpec& graph, const std::vector<std::string>& overrides);
+
+}  // namespace mocap::graph

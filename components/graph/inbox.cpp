@@ -1,0 +1,93 @@
+#include "graph/inbox.hpp"
+
+#include <algorithm>
+
+namespace mocap::graph {
+
+Inbox::Inbox(std::vector<EdgePolicy> ports) {
+  for (const EdgePolicy& policy : ports) ports_.push_back(Port{policy, {}, 0});
+}
+
+bool Inbox::push(std::size_t port_index, Packet packet) {
+  std::unique_lock lock(mutex_);
+  Port& port = ports_.at(port_index);
+  const bool eos = packet.is_end_of_stream();
+  if (!eos) {
+    if (port.policy.kind == PolicyKind::blocking) {
+      writable_.wait(lock, [&] { return closed_ || port.data_items < port.policy.capacity; });
+    } else if (port.data_items >= port.policy.capacity && !closed_) {
+      // Lossy: make room by dropping the oldest waiting data (for latest, the only one).
+      const auto oldest = std::find_if(port.items.begin(), port.items.end(),
+                                       [](const Item& i) { return !i.packet.is_end_of_stream(); });
+      port.items.erase(oldest);
+      --port.data_items;
+      --depth_;
+      ++drops_;
+    }
+  }
+  if (closed_) {
+    ++drops_;
+    return false;
+  }
+  port.items.push_back(Item{std::move(packet), next_arrival_++});
+  if (!eos) ++port.data_items;
+  max_depth_ = std::max(max_depth_, ++depth_);
+  lock.unlock();
+  readable_.notify_one();
+  return true;
+}
+
+std::optional<Inbox::Delivery> Inbox::pop() {
+  std::unique_lock lock(mutex_);
+  readable_.wait(lock, [&] { return closed_ || depth_ > 0; });
+  if (closed_) return std::nullopt;
+  Port* oldest = nullptr;
+  std::size_t oldest_index = 0;
+  for (std::size_t i = 0; i < ports_.size(); ++i) {
+    Port& port = ports_[i];
+    if (port.items.empty()) continue;
+    if (!oldest || port.items.front().arrival < oldest->items.front().arrival) {
+      oldest = &port;
+      oldest_index = i;
+    }
+  }
+  Delivery delivery{oldest_index, std::move(oldest->items.front().packet)};
+  oldest->items.pop_front();
+  if (!delivery.packet.is_end_of_stream()) --oldest->data_items;
+  --depth_;
+  lock.unlock();
+  writable_.notify_all();  // producers of different ports share the condition
+  return delivery;
+}
+
+void Inbox::close() {
+  {
+    std::lock_guard lock(mutex_);
+    closed_ = true;
+    for (Port& port : ports_) {
+      drops_ += port.data_items;
+      port.items.clear();
+      port.data_items = 0;
+    }
+    depth_ = 0;
+  }
+  readable_.notify_all();
+  writable_.notify_all();
+}
+
+std::uint64_t Inbox::drops() const {
+  std::lock_guard lock(mutex_);
+  return drops_;
+}
+
+std::size_t Inbox::depth() const {
+  std::lock_guard lock(mutex_);
+  return depth_;
+}
+
+std::size_t Inbox::max_depth() const {
+  std::lock_guard lock(mutex_);
+  return max_depth_;
+}
+
+}  // namespace mocap::graph

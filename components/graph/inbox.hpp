@@ -1,0 +1,63 @@
+#pragma once
+// The input side of a node: one bounded queue per input port, all behind one lock so the node's
+// thread can wait for "any input". Each port has its edge's policy:
+//   blocking(N)     the producer waits while N messages are queued: nothing is ever lost
+//   latest          one slot; a new message replaces the waiting one (counted as a drop)
+//   drop_oldest(N)  N slots; when full the oldest waiting message is dropped (counted)
+// End of stream is never dropped and never waits: it is always queued behind the data.
+
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <mutex>
+#include <optional>
+#include <vector>
+
+#include "graph/graph_spec.hpp"
+#include "graph/packet.hpp"
+
+namespace mocap::graph {
+
+class Inbox {
+ public:
+  explicit Inbox(std::vector<EdgePolicy> ports);
+
+  // Queues `packet` on `port` following the port's policy. Returns false when the inbox is closed
+  // (its node stopped or failed): the packet is discarded and counted as a drop.
+  bool push(std::size_t port, Packet packet);
+
+  struct Delivery {
+    std::size_t port;
+    Packet packet;
+  };
+  // Waits for the oldest waiting message of any port; nullopt once the inbox is closed.
+  std::optional<Delivery> pop();
+
+  // The node will not read any more: wakes every waiter, further pushes are discarded.
+  void close();
+
+  std::uint64_t drops() const;
+  std::size_t depth() const;
+  std::size_t max_depth() const;
+
+ private:
+  struct Item {
+    Packet packet;
+    std::uint64_t arrival;
+  };
+  struct Port {
+    EdgePolicy policy;
+    std::deque<Item> items;
+    std::size_t data_items = 0;  // items that are not end of stream
+  };
+
+  mutable std::mutex mutex_;
+  std::condition_variable readable_, writable_;
+  std::vector<Port> ports_;
+  std::uint64_t next_arrival_ = 0;
+  std::uint64_t drops_ = 0;
+  std::size_t depth_ = 0, max_depth_ = 0;
+  bool closed_ = false;
+};
+
+}  // namespace mocap::graph

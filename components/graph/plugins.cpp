@@ -1,0 +1,80 @@
+#include "graph/plugins.hpp"
+
+#include <dlfcn.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <stdexcept>
+
+#include "graph/registry.hpp"
+
+namespace mocap::graph {
+namespace {
+
+struct CloseLibrary {
+  void operator()(void* handle) const { dlclose(handle); }
+};
+using LibraryHandle = std::unique_ptr<void, CloseLibrary>;
+
+std::string last_dl_error() {
+  const char* message = dlerror();
+  return message ? message : "unknown error";
+}
+
+}  // namespace
+
+void load_plugin(const std::string& path) {
+  const std::string canonical = std::filesystem::weakly_canonical(path).string();
+  // Already loaded: RTLD_NOLOAD only succeeds for a library in the process.
+  if (LibraryHandle loaded{dlopen(canonical.c_str(), RTLD_NOW | RTLD_NOLOAD)}) return;
+
+  // Registration runs in the library's static initialisers, inside dlopen.
+  Registry::instance().set_origin(canonical);
+  LibraryHandle handle{dlopen(canonical.c_str(), RTLD_NOW | RTLD_LOCAL)};
+  Registry::instance().set_origin("built-in");
+  if (!handle) throw std::runtime_error("plugin " + path + ": " + last_dl_error());
+
+  using AbiFunction = const char* (*)();
+  const auto abi = reinterpret_cast<AbiFunction>(dlsym(handle.get(), "mocap_plugin_abi"));
+  if (!abi) {
+    throw std::runtime_error("plugin " + path + ": not a mocap plugin (no MOCAP_PLUGIN())");
+  }
+  if (std::strcmp(abi(), kPluginAbi) != 0) {
+    throw std::runtime_error("plugin " + path + ": built for " + abi() + ", this program is " +
+                             kPluginAbi);
+  }
+  // Node types of the plugin stay registered for the life of the process, so it stays loaded.
+  [[maybe_unused]] void* kept = handle.release();
+}
+
+void load_plugins_from(const std::string& file_or_directory) {
+  namespace fs = std::filesystem;
+  if (!fs::is_directory(file_or_directory)) {
+    load_plugin(file_or_directory);
+    return;
+  }
+  std::vector<fs::path> libraries;
+  for (const auto& entry : fs::directory_iterator(file_or_directory)) {
+    if (entry.is_regular_file() && entry.path().extension() == ".so")
+      libraries.push_back(entry.path());
+  }
+  std::sort(libraries.begin(), libraries.end());  // a stable order makes conflicts reproducible
+  for (const auto& library : libraries) load_plugin(library.string());
+}
+
+void load_plugins_from_environment() {
+  const char* value = std::getenv("MOCAP_PLUGIN_PATH");
+  if (!value) return;
+  std::string paths = value;
+  std::size_t start = 0;
+  while (start <= paths.size()) {
+    const std::size_t end = std::min(paths.find(':', start), paths.size());
+    const std::string entry = paths.substr(start, end - start);
+    if (!entry.empty() && std::filesystem::exists(entry)) load_plugins_from(entry);
+    start = end + 1;
+  }
+}
+
+}  // namespace mocap::graph

@@ -1,0 +1,490 @@
+#include "graph/runtime.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <condition_variable>
+#include <iostream>
+#include <mutex>
+#include <set>
+#include <thread>
+
+#include "graph/inbox.hpp"
+#include "graph/transport.hpp"
+
+namespace mocap::graph {
+
+using Clock = std::chrono::steady_clock;
+
+class NodeRunner;
+
+// One ZeroMQ edge arriving in this process: a thread that receives, decodes and queues.
+struct IncomingEdge {
+  std::string name;
+  std::unique_ptr<Receiver> receiver;
+  Inbox* inbox = nullptr;
+  std::size_t port = 0;
+  std::thread thread;
+};
+
+struct Runtime::Impl {
+  Impl(const ResolvedGraph& g, RunOptions o) : graph(g), options(std::move(o)) {}
+  ~Impl();
+
+  void log(const std::string& message) const {
+    if (options.log) {
+      options.log(message);
+    } else {
+      std::cerr << message << "\n";
+    }
+  }
+  void request_stop() {
+    {
+      std::lock_guard lock(mutex);
+      if (stopping) return;
+      stopping = true;
+      stop_time = Clock::now();
+    }
+    wake.notify_all();
+  }
+  void fail(const std::string& message) {
+    {
+      std::lock_guard lock(mutex);
+      if (error.empty()) error = message;
+    }
+    request_stop();
+  }
+  bool stop_requested() const {
+    std::lock_guard lock(mutex);
+    return stopping;
+  }
+  // True once a stop was requested longer than the drain timeout ago: waits give up then.
+  bool drain_expired() const {
+    std::lock_guard lock(mutex);
+    return stopping && Clock::now() - stop_time > options.drain_timeout;
+  }
+  bool auxiliary_released() const {
+    std::lock_guard lock(mutex);
+    return aux_released;
+  }
+  void node_finished(bool blocks_auxiliary) {
+    if (!blocks_auxiliary) return;
+    {
+      std::lock_guard lock(mutex);
+      if (--aux_blockers == 0) aux_released = true;
+    }
+    wake.notify_all();
+  }
+  // Sleeps up to `duration`; false when the caller should stop.
+  bool sleep_for(std::chrono::nanoseconds duration, bool auxiliary) {
+    std::unique_lock lock(mutex);
+    const auto must_stop = [&] { return stopping || (auxiliary && aux_released); };
+    return !wake.wait_for(lock, duration, must_stop);
+  }
+
+  void build();
+  bool uses_transport(const EdgeSpec& edge) const;
+  SocketOptions socket_options(const EdgeSpec& edge) const;
+  void add_receiving_half(const EdgeSpec& edge);
+  void add_sending_half(const EdgeSpec& edge);
+  NodeRunner* runner(std::string_view name) const;
+  void receive_loop(IncomingEdge& edge);
+  GraphStats snapshot() const;
+
+  ResolvedGraph graph;
+  RunOptions options;
+  TransportContext transport;  // first member to be built, last to go: sockets close before it
+  std::vector<std::unique_ptr<NodeRunner>> runners;
+  std::vector<std::unique_ptr<IncomingEdge>> incoming;
+  std::atomic<bool> receivers_done{false};
+
+  mutable std::mutex mutex;
+  std::condition_variable wake;
+  bool stopping = false;
+  Clock::time_point stop_time;
+  int aux_blockers = 0;
+  bool aux_released = false;
+  std::string error;
+};
+
+// A node instance, its thread and its view of the graph (the Context it sees).
+class NodeRunner final : public Context {
+ public:
+  struct RemoteOutput {
+    std::unique_ptr<Sender> sender;
+    bool lossy = false;
+  };
+  struct Output {
+    std::string type;  // resolved message type, empty when any
+    std::vector<std::pair<Inbox*, std::size_t>> local;
+    std::vector<RemoteOutput> remote;
+  };
+
+  NodeRunner(Runtime::Impl& runtime, const ResolvedNode& node, std::vector<EdgePolicy> policies,
+             std::size_t connected_inputs)
+      : runtime_(runtime),
+        node_(node),
+        contract_(node.type->contract),
+        inbox_(std::move(policies)),
+        connected_inputs_(connected_inputs),
+        outputs_(node.type->contract.outputs().size()) {
+    for (std::size_t i = 0; i < outputs_.size(); ++i) outputs_[i].type = node.output_types[i];
+    instance_ = node.type->create();
+  }
+
+  Inbox& inbox() { return inbox_; }
+  Output& output(std::size_t i) { return outputs_[i]; }
+  const ResolvedNode& resolved() const { return node_; }
+  void set_blocks_auxiliary(bool blocks) { blocks_auxiliary_ = blocks; }
+
+  void start() {
+    thread_ = std::thread([this] { run(); });
+  }
+  void join() {
+    if (thread_.joinable()) thread_.join();
+  }
+
+  NodeStats snapshot() const {
+    NodeStats s;
+    s.node = node_.name;
+    s.type = node_.type->name;
+    s.process = node_.process;
+    s.in = in_.load();
+    s.out = out_.load();
+    s.drops = inbox_.drops() + own_drops_.load();
+    const auto [p50, p95] = latency_.percentiles_us();
+    s.p50_us = p50;
+    s.p95_us = p95;
+    s.queue_depth = inbox_.depth();
+    s.max_queue_depth = inbox_.max_depth();
+    static constexpr const char* kStates[] = {"waiting", "running", "done", "failed"};
+    s.state = kStates[state_.load()];
+    return s;
+  }
+
+  // --- Context
+  const std::string& node_name() const override { return node_.name; }
+  std::string_view input_port() const override {
+    return current_ ? std::string_view(contract_.inputs()[current_port_].name) : std::string_view();
+  }
+  const Packet& current(std::string_view port) const override {
+    if (!current_ || contract_.inputs()[current_port_].name != port) {
+      throw std::logic_error("node '" + node_.name + "': input '" + std::string(port) +
+                             "' holds no message in this call (it is for '" +
+                             std::string(input_port()) + "')");
+    }
+    return *current_;
+  }
+  const Header* input_header() const override { return current_ ? &current_->header() : nullptr; }
+  void send_packet(std::string_view port, Packet packet) override;
+  void count_drop() override { ++own_drops_; }
+  void finish() override { finished_ = true; }
+  bool stop_requested() const override {
+    return runtime_.stop_requested() || (contract_.auxiliary() && runtime_.auxiliary_released());
+  }
+  bool sleep_for(std::chrono::nanoseconds duration) override {
+    const auto start = Clock::now();
+    const bool keep_going = runtime_.sleep_for(duration, contract_.auxiliary());
+    slept_ += Clock::now() - start;
+    return keep_going;
+  }
+  GraphStats stats() const override { return runtime_.snapshot(); }
+  const ParamValue& param_value(std::string_view name) const override {
+    const auto it = node_.params.find(std::string(name));
+    if (it == node_.params.end()) {
+      throw std::logic_error("node '" + node_.name + "': parameter '" + std::string(name) +
+                             "' is not in the contract of " + node_.type->name);
+    }
+    return it->second;
+  }
+
+ private:
+  enum State { waiting, running, done, failed };
+
+  void run();
+  void run_source();
+  void run_consumer();
+  void timed_process();
+  void end_outputs();
+  void record_failure(const char* stage, const std::string& what) {
+    runtime_.fail("node '" + node_.name + "' (" + node_.type->name + ") failed in " + stage + ": " +
+                  what);
+    failed_ = true;
+    inbox_.close();  // upstream must not wait for a node that no longer reads
+  }
+
+  Runtime::Impl& runtime_;
+  const ResolvedNode& node_;
+  const Contract& contract_;
+  std::unique_ptr<Node> instance_;
+  Inbox inbox_;
+  std::size_t connected_inputs_;
+  std::vector<Output> outputs_;
+  bool blocks_auxiliary_ = false;
+  std::thread thread_;
+
+  const Packet* current_ = nullptr;
+  std::size_t current_port_ = 0;
+  bool finished_ = false, failed_ = false;
+  Clock::duration slept_{};
+
+  std::atomic<std::uint64_t> in_{0}, out_{0}, own_drops_{0};
+  std::atomic<int> state_{waiting};
+  LatencyWindow latency_;
+};
+
+void NodeRunner::send_packet(std::string_view port, Packet packet) {
+  const int index = contract_.output_index(port);
+  if (index < 0) {
+    throw std::logic_error("node '" + node_.name + "' has no output '" + std::string(port) + "'");
+  }
+  Output& out = outputs_[static_cast<std::size_t>(index)];
+  if (!out.type.empty() && packet.type != out.type) {
+    throw std::logic_error("node '" + node_.name + "': output '" + std::string(port) +
+                           "' carries " + out.type + ", not " + std::string(packet.type));
+  }
+  for (auto& [inbox, input] : out.local) inbox->push(input, packet);
+  for (RemoteOutput& remote : out.remote) {
+    const auto give_up = [&] { return remote.lossy || runtime_.drain_expired(); };
+    if (!remote.sender->send(packet, give_up)) ++own_drops_;
+  }
+  ++out_;
+}
+
+void NodeRunner::timed_process() {
+  slept_ = {};
+  const auto start = Clock::now();
+  instance_->process(*this);
+  const auto busy = Clock::now() - start - slept_;
+  latency_.add(std::chrono::duration_cast<std::chrono::nanoseconds>(busy).count());
+}
+
+void NodeRunner::run_source() {
+  while (!finished_ && !stop_requested()) timed_process();
+}
+
+void NodeRunner::run_consumer() {
+  std::size_t ended = 0;
+  if (connected_inputs_ == 0) return;  // only optional, unconnected inputs: nothing will come
+  while (auto delivery = inbox_.pop()) {
+    if (delivery->packet.is_end_of_stream()) {
+      if (++ended == connected_inputs_) return;
+      continue;
+    }
+    ++in_;
+    current_port_ = delivery->port;
+    current_ = &delivery->packet;
+    timed_process();
+    current_ = nullptr;
+  }
+}
+
+void NodeRunner::run() {
+  state_ = running;
+  bool opened = false;
+  try {
+    instance_->open(*this);
+    opened = true;
+    if (contract_.is_source()) {
+      run_source();
+    } else {
+      run_consumer();
+    }
+  } catch (const std::exception& e) {
+    record_failure(opened ? "process" : "open", e.what());
+  }
+  current_ = nullptr;
+  inbox_.close();
+  if (opened) {
+    try {
+      instance_->close(*this);
+    } catch (const std::exception& e) {
+      record_failure("close", e.what());
+    }
+  }
+  end_outputs();
+  state_ = failed_ ? failed : done;
+  runtime_.node_finished(blocks_auxiliary_);
+}
+
+void NodeRunner::end_outputs() {
+  const Packet eos = Packet::end_of_stream();
+  for (Output& out : outputs_) {
+    for (auto& [inbox, input] : out.local) inbox->push(input, eos);
+    for (RemoteOutput& remote : out.remote) {
+      if (!remote.sender->send(eos, [&] { return runtime_.drain_expired(); })) {
+        runtime_.log("node '" + node_.name + "': end of stream to " + remote.sender->endpoint() +
+                     " not delivered");
+      }
+    }
+  }
+}
+
+// --- building the runtime
+
+NodeRunner* Runtime::Impl::runner(std::string_view name) const {
+  for (const auto& r : runners) {
+    if (r->resolved().name == name) return r.get();
+  }
+  return nullptr;
+}
+
+bool Runtime::Impl::uses_transport(const EdgeSpec& edge) const {
+  return !edge.transport.empty() && !options.single_process;
+}
+
+SocketOptions Runtime::Impl::socket_options(const EdgeSpec& edge) const {
+  SocketOptions socket;
+  // Lossy edges drain the socket at once and decide what to drop in the inbox, where it is
+  // counted; blocking edges let ZeroMQ queue only as much as the edge allows.
+  socket.high_water_mark = static_cast<int>(edge.policy.lossy() ? 1000 : edge.policy.capacity);
+  return socket;
+}
+
+void Runtime::Impl::add_receiving_half(const EdgeSpec& edge) {
+  NodeRunner* to = runner(edge.to.node);
+  if (!to || !uses_transport(edge)) return;
+  // The consumer binds: it is the stable end that a restarted producer reconnects to.
+  auto incoming_edge = std::make_unique<IncomingEdge>();
+  incoming_edge->name = edge.str() + " (" + edge.transport + ")";
+  incoming_edge->receiver =
+      std::make_unique<Receiver>(transport, edge.transport, socket_options(edge));
+  incoming_edge->inbox = &to->inbox();
+  incoming_edge->port =
+      static_cast<std::size_t>(to->resolved().type->contract.input_index(edge.to.port));
+  incoming.push_back(std::move(incoming_edge));
+}
+
+void Runtime::Impl::add_sending_half(const EdgeSpec& edge) {
+  NodeRunner* from = runner(edge.from.node);
+  NodeRunner* to = runner(edge.to.node);
+  if (!from) return;
+  NodeRunner::Output& out = from->output(
+      static_cast<std::size_t>(from->resolved().type->contract.output_index(edge.from.port)));
+  if (uses_transport(edge)) {
+    out.remote.push_back(
+        {std::make_unique<Sender>(transport, edge.transport, Sender::Pattern::push_connect,
+                                  socket_options(edge)),
+         edge.policy.lossy()});
+    return;
+  }
+  if (!to) {
+    throw std::runtime_error(edge.where.str() + ": edge " + edge.str() +
+                             " crosses processes without a transport");
+  }
+  out.local.emplace_back(
+      &to->inbox(),
+      static_cast<std::size_t>(to->resolved().type->contract.input_index(edge.to.port)));
+}
+
+void Runtime::Impl::build() {
+  if (!options.process.empty()) {
+    const bool known = std::any_of(graph.spec.processes.begin(), graph.spec.processes.end(),
+                                   [&](const ProcessSpec& p) { return p.name == options.process; });
+    if (!known) throw std::runtime_error("the graph has no process '" + options.process + "'");
+  }
+  for (const ResolvedNode& node : graph.nodes) {
+    if (!options.process.empty() && node.process != options.process) continue;
+    const Contract& contract = node.type->contract;
+    std::vector<EdgePolicy> policies(contract.inputs().size());
+    std::size_t connected = 0;
+    for (const EdgeSpec& edge : graph.spec.edges) {
+      if (edge.to.node != node.name) continue;
+      policies[static_cast<std::size_t>(contract.input_index(edge.to.port))] = edge.policy;
+      ++connected;
+    }
+    runners.push_back(std::make_unique<NodeRunner>(*this, node, std::move(policies), connected));
+  }
+  // Every receiving end binds before any sender connects (inproc:// wants the binder first).
+  for (const EdgeSpec& edge : graph.spec.edges) add_receiving_half(edge);
+  for (const EdgeSpec& edge : graph.spec.edges) add_sending_half(edge);
+  // Auxiliary sources (statistics reporters) run until every node that does not depend on them
+  // has finished; with no such node, until the graph is stopped.
+  std::set<std::string> downstream_of_aux;
+  for (const ResolvedNode& node : graph.nodes) {  // topological order: one pass suffices
+    if (node.type->contract.auxiliary()) downstream_of_aux.insert(node.name);
+    for (const EdgeSpec& edge : graph.spec.edges) {
+      if (edge.to.node == node.name && downstream_of_aux.count(edge.from.node)) {
+        downstream_of_aux.insert(node.name);
+      }
+    }
+  }
+  for (const auto& r : runners) {
+    const bool blocks = !downstream_of_aux.count(r->resolved().name);
+    r->set_blocks_auxiliary(blocks);
+    aux_blockers += blocks ? 1 : 0;
+  }
+}
+
+void Runtime::Impl::receive_loop(IncomingEdge& edge) {
+  std::uint64_t rejected = 0;
+  while (true) {
+    if (drain_expired() || receivers_done) {
+      // The producer's end of stream did not come in time: end the edge here.
+      edge.inbox->push(edge.port, Packet::end_of_stream());
+      return;
+    }
+    Receiver::Result result = edge.receiver->receive(std::chrono::milliseconds(100));
+    if (!result.rejected.empty()) {
+      if (++rejected <= 5 || rejected % 1000 == 0) {
+        log("edge " + edge.name + ": rejected a malformed message (" + std::to_string(rejected) +
+            " so far): " + result.rejected);
+      }
+      continue;
+    }
+    if (!result.message) continue;
+    const bool eos = result.message->packet.is_end_of_stream();
+    if (!edge.inbox->push(edge.port, std::move(result.message->packet))) return;  // consumer gone
+    if (eos) return;
+  }
+}
+
+GraphStats Runtime::Impl::snapshot() const {
+  GraphStats stats;
+  stats.header.stream = "stats";
+  stats.header.capture_ns = realtime_ns();
+  stats.graph = graph.spec.name;
+  for (const auto& r : runners) stats.nodes.push_back(r->snapshot());
+  return stats;
+}
+
+Runtime::Impl::~Impl() {
+  receivers_done = true;
+  request_stop();
+  for (auto& r : runners) r->join();
+  for (auto& e : incoming) {
+    if (e->thread.joinable()) e->thread.join();
+  }
+}
+
+// --- Runtime
+
+Runtime::Runtime(const ResolvedGraph& graph, RunOptions options)
+    : impl_(std::make_unique<Impl>(graph, std::move(options))) {
+  impl_->build();
+}
+
+Runtime::~Runtime() = default;
+
+RunResult Runtime::run() {
+  for (auto& edge : impl_->incoming) {
+    IncomingEdge* e = edge.get();
+    e->thread = std::thread([this, e] { impl_->receive_loop(*e); });
+  }
+  for (auto& r : impl_->runners) r->start();
+  for (auto& r : impl_->runners) r->join();
+  impl_->receivers_done = true;
+  for (auto& e : impl_->incoming) e->thread.join();
+  RunResult result;
+  result.stats = impl_->snapshot();
+  std::lock_guard lock(impl_->mutex);
+  result.ok = impl_->error.empty();
+  result.error = impl_->error;
+  result.stopped = impl_->stopping;
+  return result;
+}
+
+void Runtime::request_stop() { impl_->request_stop(); }
+
+GraphStats Runtime::stats() const { return impl_->snapshot(); }
+
+}  // namespace mocap::graph

@@ -1,0 +1,53 @@
+#include "graph/stats.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+namespace mocap::graph {
+
+double percentile(std::vector<std::int64_t> values, double p) {
+  if (values.empty()) return 0;
+  const auto rank = static_cast<std::size_t>(
+      std::clamp(std::ceil(p / 100.0 * static_cast<double>(values.size())) - 1.0, 0.0,
+                 static_cast<double>(values.size() - 1)));
+  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(rank),
+                   values.end());
+  return static_cast<double>(values[rank]);
+}
+
+void LatencyWindow::add(std::int64_t ns) {
+  std::lock_guard lock(mutex_);
+  samples_[count_ % kSamples] = ns;
+  ++count_;
+}
+
+std::array<double, 2> LatencyWindow::percentiles_us() const {
+  std::vector<std::int64_t> copy;
+  {
+    std::lock_guard lock(mutex_);
+    copy.assign(samples_.begin(),
+                samples_.begin() + static_cast<std::ptrdiff_t>(std::min(count_, kSamples)));
+  }
+  return {percentile(copy, 50) / 1000.0, percentile(copy, 95) / 1000.0};
+}
+
+std::string format_stats_table(const GraphStats& stats) {
+  std::ostringstream out;
+  char line[256];
+  std::snprintf(line, sizeof line, "%-16s %-20s %10s %10s %8s %10s %10s %6s %6s  %s\n", "node",
+                "type", "in", "out", "drops", "p50 us", "p95 us", "queue", "max", "state");
+  out << line;
+  for (const NodeStats& n : stats.nodes) {
+    std::snprintf(line, sizeof line,
+                  "%-16s %-20s %10llu %10llu %8llu %10.1f %10.1f %6zu %6zu  %s\n", n.node.c_str(),
+                  n.type.c_str(), static_cast<unsigned long long>(n.in),
+                  static_cast<unsigned long long>(n.out), static_cast<unsigned long long>(n.drops),
+                  n.p50_us, n.p95_us, n.queue_depth, n.max_queue_depth, n.state.c_str());
+    out << line;
+  }
+  return out.str();
+}
+
+}  // namespace mocap::graph

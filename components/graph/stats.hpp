@@ -1,0 +1,53 @@
+#pragma once
+// Per-node statistics: messages in and out, drops on its inputs, processing latency percentiles
+// and queue depth. Printed when a graph ends and available as a stream (node type graph.stats).
+
+#include <array>
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "core/messages.hpp"
+
+namespace mocap::graph {
+
+struct NodeStats {
+  std::string node, type, process;
+  std::uint64_t in = 0, out = 0, drops = 0;
+  double p50_us = 0, p95_us = 0;  // time spent in process(), over the last samples
+  std::size_t queue_depth = 0, max_queue_depth = 0;
+  std::string state;  // "running", "done", "failed"
+
+  bool operator==(const NodeStats&) const = default;
+};
+
+struct GraphStats : Message {
+  static constexpr std::string_view kTypeName = "GraphStats";
+  std::string graph;
+  std::vector<NodeStats> nodes;
+};
+
+std::string format_stats_table(const GraphStats& stats);
+
+// The last kSamples durations in a ring; percentiles over them. Writers and readers may be on
+// different threads; the lock is held for a few nanoseconds.
+class LatencyWindow {
+ public:
+  static constexpr std::size_t kSamples = 1024;
+  void add(std::int64_t ns);
+  // Returns {p50, p95} in microseconds; zeros before the first sample.
+  std::array<double, 2> percentiles_us() const;
+
+ private:
+  mutable std::mutex mutex_;
+  std::array<std::int64_t, kSamples> samples_{};
+  std::size_t count_ = 0;
+};
+
+// Percentile (0..100) of unsorted values by nearest rank; 0 for an empty set.
+double percentile(std::vector<std::int64_t> values, double p);
+
+}  // namespace mocap::graph

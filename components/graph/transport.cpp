@@ -1,0 +1,164 @@
+#include "graph/transport.hpp"
+
+#include <time.h>
+
+#include <thread>
+#include <vector>
+#include <zmq.hpp>
+
+namespace mocap::graph {
+
+std::int64_t realtime_ns() {
+  timespec now{};
+  clock_gettime(CLOCK_REALTIME, &now);
+  return std::int64_t{now.tv_sec} * 1'000'000'000 + now.tv_nsec;
+}
+
+struct TransportContext::Impl {
+  zmq::context_t context{1};
+};
+
+TransportContext::TransportContext() : impl_(std::make_unique<Impl>()) {}
+TransportContext::~TransportContext() = default;
+
+namespace {
+
+// Frames at least this large go to ZeroMQ by reference: copying them would cost more than the
+// bookkeeping. Smaller ones are copied into the message, which is cheaper than a callback.
+constexpr std::size_t kZeroCopyBytes = 4096;
+
+void release_owner(void* /*data*/, void* hint) {
+  // Runs on a ZeroMQ I/O thread once the frame is sent; drops our reference to the bytes.
+  std::unique_ptr<std::shared_ptr<const void>> owner(
+      static_cast<std::shared_ptr<const void>*>(hint));
+}
+
+zmq::message_t to_message(const wire::Frame& frame) {
+  if (frame.size < kZeroCopyBytes || !frame.owner) return zmq::message_t(frame.data, frame.size);
+  auto owner = std::make_unique<std::shared_ptr<const void>>(frame.owner);
+  zmq::message_t message(const_cast<std::byte*>(frame.data), frame.size, &release_owner,
+                         owner.get());
+  [[maybe_unused]] auto* released = owner.release();  // now owned by the ZeroMQ message
+  return message;
+}
+
+void configure(zmq::socket_t& socket, const SocketOptions& options) {
+  socket.set(zmq::sockopt::linger, options.linger_ms);
+  socket.set(zmq::sockopt::sndhwm, options.high_water_mark);
+  socket.set(zmq::sockopt::rcvhwm, options.high_water_mark);
+  socket.set(zmq::sockopt::maxmsgsize, options.max_message_bytes);
+}
+
+std::runtime_error endpoint_error(const std::string& what, const std::string& endpoint,
+                                  const zmq::error_t& e) {
+  return std::runtime_error("cannot " + what + " " + endpoint + ": " + e.what());
+}
+
+}  // namespace
+
+struct Sender::Impl {
+  zmq::socket_t socket;
+  Pattern pattern;
+};
+
+Sender::Sender(TransportContext& context, const std::string& endpoint, Pattern pattern,
+               SocketOptions options)
+    : endpoint_(endpoint) {
+  const auto type = pattern == Pattern::push_connect   ? zmq::socket_type::push
+                    : pattern == Pattern::publish_bind ? zmq::socket_type::pub
+                                                       : zmq::socket_type::xpub;
+  impl_ = std::make_unique<Impl>(Impl{zmq::socket_t(context.impl().context, type), pattern});
+  configure(impl_->socket, options);
+  impl_->socket.set(zmq::sockopt::sndtimeo, 50);
+  try {
+    if (pattern == Pattern::push_connect) {
+      impl_->socket.connect(endpoint);
+    } else {
+      impl_->socket.bind(endpoint);
+    }
+  } catch (const zmq::error_t& e) {
+    throw endpoint_error(pattern == Pattern::push_connect ? "connect to" : "bind", endpoint, e);
+  }
+}
+
+Sender::~Sender() = default;  // zmq::socket_t closes with the linger set above
+
+bool Sender::send(const Packet& packet, const std::function<bool()>& give_up) {
+  const std::vector<wire::Frame> frames = wire::encode(packet, realtime_ns());
+  std::vector<zmq::message_t> parts;
+  parts.reserve(frames.size());
+  for (const wire::Frame& frame : frames) parts.push_back(to_message(frame));
+  // ZeroMQ applies the high-water mark to the first part only: once it is accepted the rest of
+  // the message follows without waiting.
+  while (!impl_->socket.send(parts[0],
+                             parts.size() > 1 ? zmq::send_flags::sndmore : zmq::send_flags::none)) {
+    if (impl_->pattern != Pattern::push_connect) return false;  // PUB never waits; nothing to do
+    if (give_up && give_up()) return false;
+  }
+  for (std::size_t i = 1; i < parts.size(); ++i) {
+    impl_->socket.send(parts[i],
+                       i + 1 < parts.size() ? zmq::send_flags::sndmore : zmq::send_flags::none);
+  }
+  return true;
+}
+
+bool Sender::wait_for_subscriber(std::chrono::milliseconds timeout) {
+  if (impl_->pattern != Pattern::xpublish_bind) return true;
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  impl_->socket.set(zmq::sockopt::rcvtimeo, 50);
+  while (std::chrono::steady_clock::now() < deadline) {
+    zmq::message_t subscription;
+    // XPUB delivers subscriptions as messages whose first byte is 1.
+    if (impl_->socket.recv(subscription) && subscription.size() > 0 &&
+        subscription.data<unsigned char>()[0] == 1) {
+      return true;
+    }
+  }
+  return false;
+}
+
+struct Receiver::Impl {
+  zmq::socket_t socket;
+};
+
+Receiver::Receiver(TransportContext& context, const std::string& endpoint, SocketOptions options)
+    : endpoint_(endpoint) {
+  impl_ =
+      std::make_unique<Impl>(Impl{zmq::socket_t(context.impl().context, zmq::socket_type::pull)});
+  configure(impl_->socket, options);
+  try {
+    impl_->socket.bind(endpoint);
+  } catch (const zmq::error_t& e) {
+    throw endpoint_error("bind", endpoint, e);
+  }
+}
+
+Receiver::~Receiver() = default;
+
+Receiver::Result Receiver::receive(std::chrono::milliseconds timeout) {
+  zmq::pollitem_t item{impl_->socket.handle(), 0, ZMQ_POLLIN, 0};
+  if (zmq::poll(&item, 1, timeout) == 0) return {};
+  // Read every part of the message, but keep no more than the format allows.
+  std::vector<wire::Frame> frames;
+  std::size_t parts = 0;
+  bool more = true;
+  while (more) {
+    auto part = std::make_shared<zmq::message_t>();
+    if (!impl_->socket.recv(*part)) break;
+    more = part->more();
+    if (++parts <= wire::kMaxFrames + 1) {
+      frames.push_back(
+          wire::Frame{static_cast<const std::byte*>(part->data()), part->size(), part});
+    }
+  }
+  if (parts > wire::kMaxFrames + 1) {
+    return {std::nullopt, "too many frames (" + std::to_string(parts) + ")"};
+  }
+  try {
+    return {wire::decode(frames), {}};
+  } catch (const wire::WireError& e) {
+    return {std::nullopt, e.what()};
+  }
+}
+
+}  // namespace mocap::graph

@@ -1,0 +1,91 @@
+#pragma once
+// ZeroMQ edges, behind a small interface so that no other file includes zmq.hpp. A Sender
+// connects a PUSH socket (or binds a PUB/XPUB socket for streams others subscribe to); a Receiver
+// binds a PULL socket. Messages are encoded in the wire format (wire_format.hpp); large frames
+// (images) are handed to ZeroMQ without a copy on both sides.
+// Shutdown never hangs: every socket has a bounded linger, sends wait in short slices and ask
+// whether to give up, receives poll with a timeout.
+
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "graph/wire_format.hpp"
+
+namespace mocap::graph {
+
+// One per process; outlives every socket made from it.
+class TransportContext {
+ public:
+  TransportContext();
+  ~TransportContext();
+  TransportContext(const TransportContext&) = delete;
+  TransportContext& operator=(const TransportContext&) = delete;
+
+  struct Impl;
+  Impl& impl() { return *impl_; }
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
+struct SocketOptions {
+  int high_water_mark = 16;  // messages queued per socket before the sender waits (or drops)
+  int linger_ms = 1000;      // how long unsent messages may delay closing
+  std::int64_t max_message_bytes = std::int64_t{512} << 20;  // larger frames drop the connection
+};
+
+class Sender {
+ public:
+  enum class Pattern {
+    push_connect,   // one consumer, backpressure: the edge transport
+    publish_bind,   // any number of subscribers, never waits (drops when they lag)
+    xpublish_bind,  // like publish_bind, and wait_for_subscriber() works
+  };
+  // Throws std::runtime_error naming the endpoint when it cannot connect or bind.
+  Sender(TransportContext& context, const std::string& endpoint, Pattern pattern,
+         SocketOptions options = {});
+  ~Sender();
+  Sender(const Sender&) = delete;
+  Sender& operator=(const Sender&) = delete;
+
+  // Sends one message. While the peer's queue is full it waits in 50 ms slices, calling
+  // `give_up` between them; returns false (message not sent) when it does.
+  bool send(const Packet& packet, const std::function<bool()>& give_up = {});
+  // xpublish_bind: waits until at least one subscriber has subscribed.
+  bool wait_for_subscriber(std::chrono::milliseconds timeout);
+  const std::string& endpoint() const { return endpoint_; }
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  std::string endpoint_;
+};
+
+class Receiver {
+ public:
+  Receiver(TransportContext& context, const std::string& endpoint, SocketOptions options = {});
+  ~Receiver();
+  Receiver(const Receiver&) = delete;
+  Receiver& operator=(const Receiver&) = delete;
+
+  struct Result {
+    std::optional<wire::Decoded> message;  // a valid message
+    std::string rejected;                  // or why a malformed one was dropped
+  };
+  // Waits up to `timeout`; both fields empty when nothing arrived.
+  Result receive(std::chrono::milliseconds timeout);
+  const std::string& endpoint() const { return endpoint_; }
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  std::string endpoint_;
+};
+
+std::int64_t realtime_ns();  // CLOCK_REALTIME, the clock of capture timestamps
+
+}  // namespace mocap::graph

@@ -1,0 +1,373 @@
+#include "graph/validation.hpp"
+
+#include <algorithm>
+#include <regex>
+#include <set>
+#include <sstream>
+
+#include "core/input_error.hpp"
+#include "graph/plugins.hpp"
+
+namespace mocap::graph {
+
+const ResolvedNode* ResolvedGraph::find(std::string_view name) const {
+  for (const auto& node : nodes) {
+    if (node.name == name) return &node;
+  }
+  return nullptr;
+}
+
+namespace {
+
+class Checker {
+ public:
+  Checker(GraphSpec& spec, const Registry& registry) : spec_(spec), registry_(registry) {}
+
+  ResolvedGraph run() {
+    load_plugins();
+    resolve_nodes();
+    check_edges();
+    check_unconnected_inputs();
+    std::vector<std::size_t> order = topological_order();
+    resolve_types(order);
+    check_placement();
+    check_transports();
+    if (!errors_.empty()) {
+      std::string message;
+      for (const auto& e : errors_) message += (message.empty() ? "" : "\n") + e;
+      throw InputError("", message);
+    }
+    ResolvedGraph graph{spec_, {}};
+    for (std::size_t i : order) graph.nodes.push_back(std::move(nodes_[i]));
+    return graph;
+  }
+
+ private:
+  void error(const SourceLocation& where, const std::string& what) {
+    errors_.push_back(where.str() + ": " + what);
+  }
+
+  void load_plugins() {
+    for (const auto& plugin : spec_.plugins) {
+      try {
+        load_plugins_from(plugin.path);
+      } catch (const std::exception& e) {
+        error(plugin.where, e.what());
+      }
+    }
+  }
+
+  void resolve_nodes() {
+    std::set<std::string> seen;
+    static const std::regex name_pattern(R"([A-Za-z_][A-Za-z0-9_\-]*)");
+    for (const NodeSpec& spec : spec_.nodes) {
+      ResolvedNode node;
+      node.name = spec.name;
+      if (!seen.insert(spec.name).second)
+        error(spec.where, "node '" + spec.name + "' defined twice");
+      if (!std::regex_match(spec.name, name_pattern)) {
+        error(spec.where, "node name '" + spec.name + "' may hold only letters, digits, _ and -");
+      }
+      node.type = registry_.find(spec.type);
+      if (!node.type) {
+        error(spec.where, "node '" + spec.name + "': unknown node type '" + spec.type +
+                              "' (see 'mocap graph inspect')");
+      } else {
+        resolve_params(spec, node);
+        node.input_types.resize(node.type->contract.inputs().size());
+        node.output_types.resize(node.type->contract.outputs().size());
+      }
+      node.process = spec_.process_of(spec.name);
+      nodes_.push_back(std::move(node));
+    }
+  }
+
+  void resolve_params(const NodeSpec& spec, ResolvedNode& node) {
+    const Contract& contract = node.type->contract;
+    for (const auto& [name, text] : spec.params) {
+      const ParamSpec* param = contract.find_param(name);
+      if (!param) {
+        error(text.where,
+              "node '" + spec.name + "' (" + spec.type + ") has no parameter '" + name + "'");
+        continue;
+      }
+      try {
+        node.params[name] = parse_param(*param, text.text);
+      } catch (const std::invalid_argument& e) {
+        error(text.where, "node '" + spec.name + "': " + e.what());
+      }
+    }
+    for (const ParamSpec& param : contract.params()) {
+      if (node.params.count(param.name) || spec.params.count(param.name)) continue;
+      if (param.required()) {
+        error(spec.where, "node '" + spec.name + "' (" + spec.type + ") needs parameter '" +
+                              param.name + "' (" + param.doc + ")");
+      } else {
+        node.params[param.name] = *param.fallback;
+      }
+    }
+  }
+
+  int node_index(const std::string& name) const {
+    for (std::size_t i = 0; i < nodes_.size(); ++i) {
+      if (nodes_[i].name == name) return static_cast<int>(i);
+    }
+    return -1;
+  }
+
+  // Returns the port index, or -1 after reporting the problem.
+  int port_index(const EdgeSpec& edge, const PortRef& ref, bool output) {
+    const int n = node_index(ref.node);
+    if (n < 0) {
+      error(edge.where, "edge " + edge.str() + ": no node '" + ref.node + "'");
+      return -1;
+    }
+    const NodeType* type = nodes_[static_cast<std::size_t>(n)].type;
+    if (!type) return -1;  // unknown type, already reported
+    const Contract& c = type->contract;
+    const int port = output ? c.output_index(ref.port) : c.input_index(ref.port);
+    if (port < 0) {
+      std::string known;
+      for (const auto& p : output ? c.outputs() : c.inputs())
+        known += (known.empty() ? "" : ", ") + p.name;
+      error(edge.where, "edge " + edge.str() + ": node '" + ref.node + "' (" + type->name +
+                            ") has no " + (output ? "output" : "input") + " '" + ref.port + "' (" +
+                            (output ? "outputs" : "inputs") + ": " +
+                            (known.empty() ? "none" : known) + ")");
+    }
+    return port;
+  }
+
+  void check_edges() {
+    std::map<std::string, const EdgeSpec*> input_used;
+    for (const EdgeSpec& edge : spec_.edges) {
+      const int out = port_index(edge, edge.from, true);
+      const int in = port_index(edge, edge.to, false);
+      if (out < 0 || in < 0) continue;
+      if (const auto [it, fresh] = input_used.emplace(edge.to.str(), &edge); !fresh) {
+        error(edge.where, "input " + edge.to.str() + " is already fed by the edge at " +
+                              it->second->where.str() + " (one edge per input)");
+      }
+      valid_edges_.push_back(&edge);
+    }
+  }
+
+  void check_unconnected_inputs() {
+    for (const ResolvedNode& node : nodes_) {
+      if (!node.type) continue;
+      for (const PortSpec& port : node.type->contract.inputs()) {
+        if (port.optional) continue;
+        const bool connected = std::any_of(
+            spec_.edges.begin(), spec_.edges.end(),
+            [&](const EdgeSpec& e) { return e.to.node == node.name && e.to.port == port.name; });
+        if (!connected) {
+          error(spec_.find_node(node.name)->where,
+                "input " + node.name + "." + port.name + " is not connected");
+        }
+      }
+    }
+  }
+
+  // Kahn's algorithm; nodes left over sit on a cycle.
+  std::vector<std::size_t> topological_order() {
+    std::vector<int> pending(nodes_.size(), 0);
+    for (const EdgeSpec* e : valid_edges_)
+      ++pending[static_cast<std::size_t>(node_index(e->to.node))];
+    std::vector<std::size_t> order, ready;
+    for (std::size_t i = 0; i < nodes_.size(); ++i) {
+      if (pending[i] == 0) ready.push_back(i);
+    }
+    while (!ready.empty()) {
+      const std::size_t n = ready.front();
+      ready.erase(ready.begin());
+      order.push_back(n);
+      for (const EdgeSpec* e : valid_edges_) {
+        if (e->from.node != nodes_[n].name) continue;
+        const auto to = static_cast<std::size_t>(node_index(e->to.node));
+        if (--pending[to] == 0) ready.push_back(to);
+      }
+    }
+    for (const EdgeSpec* e : valid_edges_) {
+      if (pending[static_cast<std::size_t>(node_index(e->to.node))] > 0 &&
+          pending[static_cast<std::size_t>(node_index(e->from.node))] > 0) {
+        error(e->where, "edge " + e->str() + " closes a cycle (graphs must be acyclic)");
+        break;
+      }
+    }
+    for (std::size_t i = 0; i < nodes_.size(); ++i) {
+      if (pending[i] > 0) order.push_back(i);  // keep every node; the error is already reported
+    }
+    return order;
+  }
+
+  // Propagates message types along edges in topological order; checks each edge's types.
+  void resolve_types(const std::vector<std::size_t>& order) {
+    for (std::size_t n : order) {
+      ResolvedNode& node = nodes_[n];
+      if (!node.type) continue;
+      const Contract& c = node.type->contract;
+      for (std::size_t o = 0; o < c.outputs().size(); ++o) {
+        const PortSpec& port = c.outputs()[o];
+        node.output_types[o] =
+            port.same_as.empty()
+                ? port.type
+                : node.input_types[static_cast<std::size_t>(c.input_index(port.same_as))];
+      }
+      for (const EdgeSpec* e : valid_edges_) {
+        if (e->from.node != node.name) continue;
+        ResolvedNode& to = nodes_[static_cast<std::size_t>(node_index(e->to.node))];
+        const std::string& sent =
+            node.output_types[static_cast<std::size_t>(c.output_index(e->from.port))];
+        const int in = to.type->contract.input_index(e->to.port);
+        const std::string& accepted = to.type->contract.inputs()[static_cast<std::size_t>(in)].type;
+        if (!accepted.empty() && !sent.empty() && accepted != sent) {
+          error(e->where, "edge " + e->str() + ": type mismatch, " + e->from.str() + " sends " +
+                              sent + " but " + e->to.str() + " takes " + accepted);
+        }
+        to.input_types[static_cast<std::size_t>(in)] = accepted.empty() ? sent : accepted;
+      }
+    }
+  }
+
+  void check_placement() {
+    if (spec_.processes.empty()) return;
+    std::map<std::string, std::string> placed;
+    std::set<std::string> process_names;
+    for (const ProcessSpec& process : spec_.processes) {
+      if (!process_names.insert(process.name).second) {
+        error(process.where, "process '" + process.name + "' defined twice");
+      }
+      for (const std::string& member : process.nodes) {
+        if (node_index(member) < 0)
+          error(process.where, "process '" + process.name + "': no node '" + member + "'");
+        if (const auto [it, fresh] = placed.emplace(member, process.name); !fresh) {
+          error(process.where, "node '" + member + "' is placed in both '" + it->second +
+                                   "' and '" + process.name + "'");
+        }
+      }
+    }
+    for (const NodeSpec& node : spec_.nodes) {
+      if (!placed.count(node.name)) {
+        error(node.where, "node '" + node.name + "' is not placed in any process");
+      }
+    }
+    for (const EdgeSpec& edge : spec_.edges) {
+      const std::string from = spec_.process_of(edge.from.node),
+                        to = spec_.process_of(edge.to.node);
+      if (from == to || from.empty() || to.empty()) continue;
+      if (edge.transport.empty() || edge.transport.rfind("inproc://", 0) == 0) {
+        error(edge.where, "edge " + edge.str() + " crosses from process '" + from + "' to '" + to +
+                              "': give it an ipc:// or tcp:// transport");
+      }
+    }
+  }
+
+  void check_transports() {
+    static const std::regex tcp(R"(tcp://(\[[^\]]+\]|[^:]+):(\d+))");
+    std::map<std::string, const EdgeSpec*> used;
+    for (const EdgeSpec& edge : spec_.edges) {
+      if (edge.transport.empty()) continue;
+      if (const auto [it, fresh] = used.emplace(edge.transport, &edge); !fresh) {
+        error(edge.where, "endpoint " + edge.transport + " is already used by the edge at " +
+                              it->second->where.str());
+      }
+      std::smatch match;
+      if (edge.transport.rfind("tcp://", 0) != 0) continue;
+      if (!std::regex_match(edge.transport, match, tcp)) {
+        error(edge.where, "tcp endpoint '" + edge.transport + "' must be tcp://host:port");
+        continue;
+      }
+      const std::string host = match[1].str();
+      const bool loopback = host == "127.0.0.1" || host == "localhost" || host == "[::1]";
+      if (!loopback && !spec_.allow_network) {
+        error(edge.where, "edge " + edge.str() + " listens beyond this machine (" + host +
+                              "); set 'allow_network: true' in the graph to allow it");
+      }
+    }
+  }
+
+  GraphSpec& spec_;
+  const Registry& registry_;
+  std::vector<ResolvedNode> nodes_;
+  std::vector<const EdgeSpec*> valid_edges_;
+  std::vector<std::string> errors_;
+};
+
+}  // namespace
+
+ResolvedGraph resolve(GraphSpec spec, const Registry& registry) {
+  return Checker(spec, registry).run();
+}
+
+std::string to_dot(const ResolvedGraph& graph) {
+  std::ostringstream out;
+  out << "digraph \"" << (graph.spec.name.empty() ? "graph" : graph.spec.name) << "\" {\n"
+      << "  rankdir=LR;\n  node [shape=box, fontname=\"Helvetica\"];\n";
+  auto node_line = [&](const ResolvedNode& n, const char* indent) {
+    out << indent << "\"" << n.name << "\" [label=\"" << n.name << "\\n"
+        << n.type->name << "\"];\n";
+  };
+  for (const ProcessSpec& process : graph.spec.processes) {
+    out << "  subgraph \"cluster_" << process.name << "\" {\n    label=\"" << process.name
+        << "\";\n";
+    for (const std::string& member : process.nodes) {
+      if (const ResolvedNode* n = graph.find(member)) node_line(*n, "    ");
+    }
+    out << "  }\n";
+  }
+  for (const ResolvedNode& n : graph.nodes) {
+    if (n.process.empty()) node_line(n, "  ");
+  }
+  for (const EdgeSpec& e : graph.spec.edges) {
+    const ResolvedNode* from = graph.find(e.from.node);
+    const auto port = static_cast<std::size_t>(from->type->contract.output_index(e.from.port));
+    out << "  \"" << e.from.node << "\" -> \"" << e.to.node << "\" [label=\"" << e.from.port
+        << " -> " << e.to.port << "\\n"
+        << from->output_types[port] << ", " << e.policy.str()
+        << (e.transport.empty() ? "" : "\\n" + e.transport) << "\""
+        << (e.policy.lossy() ? ", style=dashed" : "") << "];\n";
+  }
+  out << "}\n";
+  return out.str();
+}
+
+std::string describe(const NodeType& type) {
+  std::ostringstream out;
+  const Contract& c = type.contract;
+  out << type.name << "\n  " << (c.doc().empty() ? "(no description)" : c.doc()) << "\n"
+      << "  from: " << type.origin << "\n";
+  auto port_type = [](const PortSpec& p) {
+    return !p.type.empty()      ? p.type
+           : !p.same_as.empty() ? "same as " + p.same_as
+                                : std::string("any");
+  };
+  out << "\n  inputs:\n";
+  if (c.inputs().empty()) out << "    (none: a source)\n";
+  for (const auto& p : c.inputs()) {
+    out << "    " << p.name << " : " << port_type(p) << (p.optional ? " (optional)" : "")
+        << (p.doc.empty() ? "" : "  " + p.doc) << "\n";
+  }
+  out << "\n  outputs:\n";
+  if (c.outputs().empty()) out << "    (none: a sink)\n";
+  for (const auto& p : c.outputs()) {
+    out << "    " << p.name << " : " << port_type(p) << (p.doc.empty() ? "" : "  " + p.doc) << "\n";
+  }
+  out << "\n  parameters:\n";
+  if (c.params().empty()) out << "    (none)\n";
+  for (const auto& p : c.params()) {
+    out << "    " << p.name << " : " << name(p.type);
+    if (p.fallback) {
+      out << " = " << to_text(*p.fallback);
+    } else {
+      out << " (required)";
+    }
+    if (p.range.min || p.range.max) {
+      out << " in [" << (p.range.min ? to_text(*p.range.min) : "-inf") << ", "
+          << (p.range.max ? to_text(*p.range.max) : "inf") << "]";
+    }
+    out << "\n        " << p.doc << "\n";
+  }
+  return out.str();
+}
+
+}  // namespace mocap::graph

@@ -1,0 +1,393 @@
+#include "graph/wire_format.hpp"
+
+#include <bit>
+#include <cstring>
+#include <nlohmann/json.hpp>
+
+#include "graph/stats.hpp"
+
+namespace mocap::graph::wire {
+
+static_assert(std::endian::native == std::endian::little,
+              "the wire format is little-endian; add byte swapping for this platform");
+
+namespace {
+
+class Writer {
+ public:
+  template <class T>
+  void put(T value) {
+    const auto* p = reinterpret_cast<const std::byte*>(&value);
+    bytes_.insert(bytes_.end(), p, p + sizeof(T));
+  }
+  void put_bytes(const void* data, std::size_t size) {
+    const auto* p = static_cast<const std::byte*>(data);
+    bytes_.insert(bytes_.end(), p, p + size);
+  }
+  Frame frame() && {
+    auto owned = std::make_shared<std::vector<std::byte>>(std::move(bytes_));
+    return Frame{owned->data(), owned->size(), owned};
+  }
+
+ private:
+  std::vector<std::byte> bytes_;
+};
+
+class Reader {
+ public:
+  Reader(const Frame& frame, const char* what) : frame_(frame), what_(what) {}
+  template <class T>
+  T get() {
+    need(sizeof(T));
+    T value;
+    std::memcpy(&value, frame_.data + pos_, sizeof(T));
+    pos_ += sizeof(T);
+    return value;
+  }
+  std::string get_string(std::size_t size) {
+    need(size);
+    std::string text(reinterpret_cast<const char*>(frame_.data + pos_), size);
+    pos_ += size;
+    return text;
+  }
+  void skip(std::size_t size) {
+    need(size);
+    pos_ += size;
+  }
+  void expect_end() const {
+    if (pos_ != frame_.size) {
+      throw WireError(std::string(what_) + " frame has " + std::to_string(frame_.size - pos_) +
+                      " unexpected trailing bytes");
+    }
+  }
+
+ private:
+  void need(std::size_t size) const {
+    if (frame_.size - pos_ < size) throw WireError(std::string(what_) + " frame is truncated");
+  }
+  const Frame& frame_;
+  const char* what_;
+  std::size_t pos_ = 0;
+};
+
+void expect_size(const Frame& frame, std::size_t expected, const char* what) {
+  if (frame.size != expected) {
+    throw WireError(std::string(what) + " frame has " + std::to_string(frame.size) +
+                    " bytes, expected " + std::to_string(expected));
+  }
+}
+
+template <class T>
+std::shared_ptr<T> with_header(const Header& header) {
+  auto message = std::make_shared<T>();
+  message->header = header;
+  return message;
+}
+
+// --- encoders: return the payload frames of one message type
+
+std::vector<Frame> encode_video(const VideoFrame& m) {
+  const ImageBuffer& image = m.image;
+  Writer meta;
+  meta.put<std::int32_t>(m.camera_id);
+  meta.put<std::uint32_t>(static_cast<std::uint32_t>(image.width()));
+  meta.put<std::uint32_t>(static_cast<std::uint32_t>(image.height()));
+  meta.put<std::uint32_t>(static_cast<std::uint32_t>(image.stride()));
+  meta.put<std::uint8_t>(static_cast<std::uint8_t>(image.format()));
+  meta.put_bytes("\0\0\0", 3);
+  std::vector<Frame> frames;
+  frames.push_back(std::move(meta).frame());
+  frames.push_back(Frame{image.data(), image.size_bytes(), image.owner()});  // no copy
+  return frames;
+}
+
+std::vector<Frame> encode_people_2d(const People2D& m) {
+  const std::size_t joints = m.people.empty() ? 0 : m.people.front().joints.size();
+  Writer meta, values;
+  meta.put<std::uint16_t>(static_cast<std::uint16_t>(m.layout));
+  meta.put<std::uint16_t>(static_cast<std::uint16_t>(joints));
+  meta.put<std::uint32_t>(static_cast<std::uint32_t>(m.people.size()));
+  for (const Person2D& person : m.people) {
+    if (person.joints.size() != joints)
+      throw WireError("People2D: people with different joint counts");
+    meta.put<std::int32_t>(person.id);
+    meta.put<float>(person.box.x);
+    meta.put<float>(person.box.y);
+    meta.put<float>(person.box.width);
+    meta.put<float>(person.box.height);
+    for (const Keypoint2D& k : person.joints) {
+      values.put<float>(k.x);
+      values.put<float>(k.y);
+      values.put<float>(k.confidence);
+    }
+  }
+  std::vector<Frame> frames;
+  frames.push_back(std::move(meta).frame());
+  frames.push_back(std::move(values).frame());
+  return frames;
+}
+
+std::vector<Frame> encode_people_3d(const People3D& m) {
+  Writer meta, positions, rotations, clips;
+  meta.put<std::uint32_t>(static_cast<std::uint32_t>(m.people.size()));
+  for (const Person3D& p : m.people) {
+    meta.put<std::int32_t>(p.id);
+    meta.put<std::int32_t>(p.provenance.view);
+    meta.put<std::int64_t>(p.provenance.frame);
+    for (float v : {p.root.rotation.w, p.root.rotation.x, p.root.rotation.y, p.root.rotation.z})
+      meta.put(v);
+    for (int i = 0; i < 3; ++i) meta.put<float>(p.root.translation[i]);
+    for (const glm::vec3& v : p.positions) {
+      for (int i = 0; i < 3; ++i) positions.put<float>(v[i]);
+    }
+    for (const glm::quat& q : p.rotations) {
+      for (float v : {q.w, q.x, q.y, q.z}) rotations.put(v);
+    }
+    if (p.provenance.clip.size() > 0xFFFF) throw WireError("People3D: clip name too long");
+    clips.put<std::uint16_t>(static_cast<std::uint16_t>(p.provenance.clip.size()));
+    clips.put_bytes(p.provenance.clip.data(), p.provenance.clip.size());
+  }
+  std::vector<Frame> frames;
+  frames.push_back(std::move(meta).frame());
+  frames.push_back(std::move(positions).frame());
+  frames.push_back(std::move(rotations).frame());
+  frames.push_back(std::move(clips).frame());
+  return frames;
+}
+
+std::vector<Frame> encode_stats(const GraphStats& m) {
+  nlohmann::json nodes = nlohmann::json::array();
+  for (const NodeStats& n : m.nodes) {
+    nodes.push_back({{"node", n.node},
+                     {"type", n.type},
+                     {"process", n.process},
+                     {"in", n.in},
+                     {"out", n.out},
+                     {"drops", n.drops},
+                     {"p50_us", n.p50_us},
+                     {"p95_us", n.p95_us},
+                     {"queue_depth", n.queue_depth},
+                     {"max_queue_depth", n.max_queue_depth},
+                     {"state", n.state}});
+  }
+  const std::string text = nlohmann::json{{"graph", m.graph}, {"nodes", nodes}}.dump();
+  Writer json;
+  json.put_bytes(text.data(), text.size());
+  std::vector<Frame> frames;
+  frames.push_back(std::move(json).frame());
+  return frames;
+}
+
+// --- decoders
+
+Packet decode_video(const Header& header, std::span<const Frame> payload) {
+  Reader meta(payload[0], "VideoFrame meta");
+  auto m = with_header<VideoFrame>(header);
+  m->camera_id = meta.get<std::int32_t>();
+  const auto width = meta.get<std::uint32_t>(), height = meta.get<std::uint32_t>();
+  const auto stride = meta.get<std::uint32_t>();
+  const auto format = pixel_format_from_code(meta.get<std::uint8_t>());
+  meta.skip(3);
+  meta.expect_end();
+  if (!format) throw WireError("VideoFrame: unknown pixel format");
+  if (width > kMaxImageSide || height > kMaxImageSide || stride > kMaxImageSide * 4) {
+    throw WireError("VideoFrame: image size beyond the limits");
+  }
+  if (stride < width * static_cast<std::uint32_t>(bytes_per_pixel(*format))) {
+    throw WireError("VideoFrame: stride smaller than a row");
+  }
+  expect_size(payload[1], std::size_t{stride} * height, "VideoFrame pixels");
+  m->image = ImageBuffer(static_cast<int>(width), static_cast<int>(height),
+                         static_cast<int>(stride), *format, payload[1].owner, payload[1].data);
+  return Packet::of<VideoFrame>(std::move(m));
+}
+
+Packet decode_people_2d(const Header& header, std::span<const Frame> payload) {
+  Reader meta(payload[0], "People2D meta");
+  auto m = with_header<People2D>(header);
+  const auto layout = meta.get<std::uint16_t>();
+  const auto joints = meta.get<std::uint16_t>();
+  const auto count = meta.get<std::uint32_t>();
+  if (layout > static_cast<std::uint16_t>(LayoutId::humaneva15))
+    throw WireError("People2D: unknown layout");
+  if (count > kMaxPeople || joints > kMaxJoints)
+    throw WireError("People2D: counts beyond the limits");
+  expect_size(payload[0], 8 + std::size_t{count} * 20, "People2D meta");
+  expect_size(payload[1], std::size_t{count} * joints * 12, "People2D keypoints");
+  m->layout = static_cast<LayoutId>(layout);
+  Reader values(payload[1], "People2D keypoints");
+  m->people.resize(count);
+  for (Person2D& person : m->people) {
+    person.id = meta.get<std::int32_t>();
+    person.box = {meta.get<float>(), meta.get<float>(), meta.get<float>(), meta.get<float>()};
+    person.joints.resize(joints);
+    for (Keypoint2D& k : person.joints)
+      k = {values.get<float>(), values.get<float>(), values.get<float>()};
+  }
+  return Packet::of<People2D>(std::move(m));
+}
+
+Packet decode_people_3d(const Header& header, std::span<const Frame> payload) {
+  Reader meta(payload[0], "People3D meta");
+  auto m = with_header<People3D>(header);
+  const auto count = meta.get<std::uint32_t>();
+  if (count > kMaxPeople) throw WireError("People3D: person count beyond the limits");
+  expect_size(payload[0], 4 + std::size_t{count} * 44, "People3D meta");
+  expect_size(payload[1], std::size_t{count} * kBodyJoints * 12, "People3D positions");
+  expect_size(payload[2], std::size_t{count} * kBodyJoints * 16, "People3D rotations");
+  Reader positions(payload[1], "People3D positions"), rotations(payload[2], "People3D rotations");
+  Reader clips(payload[3], "People3D provenance");
+  m->people.resize(count);
+  for (Person3D& p : m->people) {
+    p.id = meta.get<std::int32_t>();
+    p.provenance.view = meta.get<std::int32_t>();
+    p.provenance.frame = meta.get<std::int64_t>();
+    const float w = meta.get<float>(), x = meta.get<float>(), y = meta.get<float>(),
+                z = meta.get<float>();
+    p.root.rotation = glm::quat(w, x, y, z);
+    for (int i = 0; i < 3; ++i) p.root.translation[i] = meta.get<float>();
+    for (glm::vec3& v : p.positions) {
+      for (int i = 0; i < 3; ++i) v[i] = positions.get<float>();
+    }
+    for (glm::quat& q : p.rotations) {
+      const float qw = rotations.get<float>(), qx = rotations.get<float>();
+      const float qy = rotations.get<float>(), qz = rotations.get<float>();
+      q = glm::quat(qw, qx, qy, qz);
+    }
+    p.provenance.clip = clips.get_string(clips.get<std::uint16_t>());
+  }
+  clips.expect_end();
+  return Packet::of<People3D>(std::move(m));
+}
+
+Packet decode_stats(const Header& header, std::span<const Frame> payload) {
+  if (payload[0].size > kMaxStatsBytes) throw WireError("GraphStats: too large");
+  auto m = with_header<GraphStats>(header);
+  try {
+    const auto json =
+        nlohmann::json::parse(reinterpret_cast<const char*>(payload[0].data),
+                              reinterpret_cast<const char*>(payload[0].data) + payload[0].size);
+    m->graph = json.at("graph").get<std::string>();
+    for (const auto& n : json.at("nodes")) {
+      m->nodes.push_back(NodeStats{n.at("node"), n.at("type"), n.at("process"), n.at("in"),
+                                   n.at("out"), n.at("drops"), n.at("p50_us"), n.at("p95_us"),
+                                   n.at("queue_depth"), n.at("max_queue_depth"), n.at("state")});
+    }
+  } catch (const nlohmann::json::exception& e) {
+    throw WireError(std::string("GraphStats: ") + e.what());
+  }
+  return Packet::of<GraphStats>(std::move(m));
+}
+
+struct TypeInfo {
+  TypeCode code;
+  std::string_view name;
+  std::size_t payload_frames;
+};
+constexpr TypeInfo kTypes[] = {
+    {TypeCode::end_of_stream, EndOfStream::kTypeName, 0},
+    {TypeCode::video_frame, VideoFrame::kTypeName, 2},
+    {TypeCode::people_2d, People2D::kTypeName, 2},
+    {TypeCode::people_3d, People3D::kTypeName, 4},
+    {TypeCode::graph_stats, GraphStats::kTypeName, 1},
+};
+
+const TypeInfo& info_by_name(std::string_view name) {
+  for (const TypeInfo& t : kTypes) {
+    if (t.name == name) return t;
+  }
+  throw WireError("message type " + std::string(name) + " has no wire encoding");
+}
+
+}  // namespace
+
+std::vector<Frame> encode(const Packet& packet, std::int64_t send_ns) {
+  const TypeInfo& info = info_by_name(packet.type);
+  std::vector<Frame> payload;
+  switch (info.code) {
+    case TypeCode::end_of_stream:
+      break;
+    case TypeCode::video_frame:
+      payload = encode_video(static_cast<const VideoFrame&>(*packet.message));
+      break;
+    case TypeCode::people_2d:
+      payload = encode_people_2d(static_cast<const People2D&>(*packet.message));
+      break;
+    case TypeCode::people_3d:
+      payload = encode_people_3d(static_cast<const People3D&>(*packet.message));
+      break;
+    case TypeCode::graph_stats:
+      payload = encode_stats(static_cast<const GraphStats&>(*packet.message));
+      break;
+  }
+  const Header& h = packet.header();
+  if (h.stream.size() > kMaxStreamIdBytes) throw WireError("stream id longer than 1024 bytes");
+  Writer header;
+  header.put_bytes(kMagic, 4);
+  header.put<std::uint16_t>(kVersion);
+  header.put<std::uint16_t>(static_cast<std::uint16_t>(info.code));
+  header.put<std::uint64_t>(h.seq);
+  header.put<std::int64_t>(h.capture_ns);
+  header.put<std::int64_t>(h.frame);
+  header.put<std::int64_t>(send_ns);
+  header.put<std::uint16_t>(static_cast<std::uint16_t>(h.stream.size()));
+  header.put<std::uint16_t>(static_cast<std::uint16_t>(payload.size()));
+  header.put_bytes(h.stream.data(), h.stream.size());
+  std::vector<Frame> frames;
+  frames.reserve(payload.size() + 1);
+  frames.push_back(std::move(header).frame());
+  for (Frame& f : payload) frames.push_back(std::move(f));
+  return frames;
+}
+
+Decoded decode(std::span<const Frame> frames) {
+  if (frames.empty()) throw WireError("empty message");
+  if (frames.size() > kMaxFrames + 1)
+    throw WireError("too many frames (" + std::to_string(frames.size()) + ")");
+  Reader reader(frames[0], "header");
+  if (frames[0].size < kHeaderBytes || std::memcmp(frames[0].data, kMagic, 4) != 0) {
+    throw WireError("not a mocap message (bad magic or short header)");
+  }
+  reader.skip(4);
+  const auto version = reader.get<std::uint16_t>();
+  if (version != kVersion) {
+    throw WireError("wire format version " + std::to_string(version) +
+                    " is not supported (this program speaks " + std::to_string(kVersion) + ")");
+  }
+  const auto code = reader.get<std::uint16_t>();
+  const TypeInfo* info = nullptr;
+  for (const TypeInfo& t : kTypes) {
+    if (static_cast<std::uint16_t>(t.code) == code) info = &t;
+  }
+  if (!info) throw WireError("unknown message type code " + std::to_string(code));
+  Header header;
+  header.seq = reader.get<std::uint64_t>();
+  header.capture_ns = reader.get<std::int64_t>();
+  header.frame = reader.get<std::int64_t>();
+  const auto send_ns = reader.get<std::int64_t>();
+  const auto stream_bytes = reader.get<std::uint16_t>();
+  const auto payload_frames = reader.get<std::uint16_t>();
+  if (stream_bytes > kMaxStreamIdBytes) throw WireError("stream id too long");
+  header.stream = reader.get_string(stream_bytes);
+  reader.expect_end();
+  if (payload_frames != info->payload_frames || frames.size() != payload_frames + 1u) {
+    throw WireError(std::string(info->name) + " needs " + std::to_string(info->payload_frames) +
+                    " payload frames, got " + std::to_string(frames.size() - 1));
+  }
+  const auto payload = frames.subspan(1);
+  switch (info->code) {
+    case TypeCode::end_of_stream:
+      return {Packet::end_of_stream(header), send_ns};
+    case TypeCode::video_frame:
+      return {decode_video(header, payload), send_ns};
+    case TypeCode::people_2d:
+      return {decode_people_2d(header, payload), send_ns};
+    case TypeCode::people_3d:
+      return {decode_people_3d(header, payload), send_ns};
+    case TypeCode::graph_stats:
+      return {decode_stats(header, payload), send_ns};
+  }
+  throw WireError("unknown message type");
+}
+
+}  // namespace mocap::graph::wire

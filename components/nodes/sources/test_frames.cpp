@@ -1,0 +1,66 @@
+// test.frames: a source of synthetic video frames (each row filled with (seq + row) mod 256), for
+// tests and the transport benchmark.
+
+#include <cstring>
+
+#include "graph/registry.hpp"
+#include "graph/transport.hpp"
+
+namespace mocap::nodes {
+using namespace mocap::graph;
+
+class TestFrames : public Node {
+ public:
+  static void contract(Contract& c) {
+    c.doc("Emits `count` synthetic video frames of width x height pixels");
+    c.output<VideoFrame>("frames");
+    c.param<std::int64_t>("count", 10, "frames before end of stream (0: until stopped)", {0, 1e12});
+    c.param<std::int64_t>("width", 640, "pixels", {1, 16384});
+    c.param<std::int64_t>("height", 480, "pixels", {1, 16384});
+    c.param<std::string>("format", "rgb8", "pixel format: gray8, rgb8, bgr8, rgba8, bgra8");
+    c.param<double>("fps", 0.0, "frames per second (0: as fast as possible)", {0, 1000});
+    c.param<std::int64_t>("camera", 0, "camera id", {0, 1000});
+  }
+
+  void open(Context& ctx) override {
+    count_ = ctx.param<std::uint64_t>("count");
+    width_ = ctx.param<int>("width");
+    height_ = ctx.param<int>("height");
+    camera_ = ctx.param<int>("camera");
+    const auto format = pixel_format_from_name(ctx.param<std::string>("format"));
+    if (!format)
+      throw std::invalid_argument("unknown pixel format '" + ctx.param<std::string>("format") +
+                                  "'");
+    format_ = *format;
+    const double fps = ctx.param<double>("fps");
+    interval_ = std::chrono::nanoseconds(fps > 0 ? static_cast<std::int64_t>(1e9 / fps) : 0);
+  }
+
+  void process(Context& ctx) override {
+    if (count_ != 0 && seq_ >= count_) return ctx.finish();
+    if (seq_ > 0 && interval_.count() > 0 && !ctx.sleep_for(interval_)) return;
+    VideoFrame frame;
+    frame.header = {"camera" + std::to_string(camera_), seq_, realtime_ns(),
+                    static_cast<std::int64_t>(seq_)};
+    frame.camera_id = camera_;
+    frame.image = ImageBuffer(width_, height_, format_);
+    const auto pixels = frame.image.pixels_for_writing();
+    for (int row = 0; row < height_; ++row) {
+      std::memset(pixels.data() + static_cast<std::size_t>(row) * frame.image.stride(),
+                  static_cast<int>((seq_ + static_cast<std::uint64_t>(row)) & 0xFF),
+                  static_cast<std::size_t>(frame.image.stride()));
+    }
+    ctx.send("frames", std::move(frame));
+    ++seq_;
+  }
+
+ private:
+  std::uint64_t count_ = 0, seq_ = 0;
+  int width_ = 0, height_ = 0, camera_ = 0;
+  PixelFormat format_ = PixelFormat::rgb8;
+  std::chrono::nanoseconds interval_{0};
+};
+
+MOCAP_REGISTER_NODE("test.frames", TestFrames)
+
+}  // namespace mocap::nodes
