@@ -34,6 +34,17 @@ const FamilyTable kCmu31 = {{
     {"LeftUpLeg", "RightUpLeg"},
 }};
 
+// CMU's own ASF/AMC: a joint sits at the start of the bone of the same name.
+const FamilyTable kCmuAsf = {{
+    {"head", nullptr, {}, true},  // top of the head: the end of the head bone
+    {"upperneck"},
+    {"rhumerus"}, {"rradius"}, {"rwrist"},
+    {"lhumerus"}, {"lradius"}, {"lwrist"},
+    {"rfemur"}, {"rtibia"}, {"rfoot"},
+    {"lfemur"}, {"ltibia"}, {"lfoot"},
+    {"lfemur", "rfemur"},
+}};
+
 const FamilyTable kCmuDaz = {{
     {"leftEye", "rightEye"},  // eye level: the figure has no head-top point
     {"neck"},
@@ -59,11 +70,11 @@ const FamilyTable kBandai = {{
 const std::array<std::vector<const char*>, kBodyJoints> kGenericNames = {{
     {"head", "headtop", "head_end"},
     {"neck1", "neck", "upperneck"},
-    {"rightarm", "rshldr", "upperarmr", "rupperarm", "rightupperarm", "rshoulder"},
-    {"rightforearm", "rforearm", "lowerarmr", "rlowerarm", "rightlowerarm", "relbow"},
+    {"rightarm", "rshldr", "upperarmr", "rupperarm", "rightupperarm", "rshoulder", "rhumerus"},
+    {"rightforearm", "rforearm", "lowerarmr", "rlowerarm", "rightlowerarm", "relbow", "rradius"},
     {"righthand", "rhand", "handr", "rwrist"},
-    {"leftarm", "lshldr", "upperarml", "lupperarm", "leftupperarm", "lshoulder"},
-    {"leftforearm", "lforearm", "lowerarml", "llowerarm", "leftlowerarm", "lelbow"},
+    {"leftarm", "lshldr", "upperarml", "lupperarm", "leftupperarm", "lshoulder", "lhumerus"},
+    {"leftforearm", "lforearm", "lowerarml", "llowerarm", "leftlowerarm", "lelbow", "lradius"},
     {"lefthand", "lhand", "handl", "lwrist"},
     {"rightupleg", "rthigh", "upperlegr", "rupperleg", "rightupperleg", "rhip", "rfemur"},
     {"rightleg", "rshin", "lowerlegr", "rlowerleg", "rightlowerleg", "rknee", "rtibia"},
@@ -167,6 +178,7 @@ BodyMapping generic_mapping(const Skeleton& s, const std::string& source) {
 std::string_view family_name(Family f) {
   switch (f) {
     case Family::cmu31: return "cmu31";
+    case Family::cmu_asf: return "cmu_asf";
     case Family::cmu_daz: return "cmu_daz";
     case Family::bandai: return "bandai";
     case Family::generic: return "generic";
@@ -180,6 +192,12 @@ BodyMapping map_to_body(const Skeleton& s, const std::string& source) {
     m.metres_per_unit = kCmuMetresPerUnit;
     m.first_frame_is_reference = true;
     m.notes = "cgspeed CMU: head = Head End Site (top of head), neck = Neck1, root = midpoint of the UpLeg joints";
+    return m;
+  }
+  if (has_all(s, {"lhipjoint", "lfemur", "ltibia", "lhumerus", "lradius", "upperneck", "head"})) {
+    BodyMapping m = from_table(s, kCmuAsf, Family::cmu_asf, source);
+    m.metres_per_unit = kCmuMetresPerUnit;
+    m.notes = "CMU ASF/AMC: head = end of the head bone, neck = upperneck, root = midpoint of the femur starts";
     return m;
   }
   if (has_all(s, {"hip", "abdomen", "chest", "rShldr", "lShldr", "rThigh", "lThigh", "leftEye"})) {

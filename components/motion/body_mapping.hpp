@@ -15,7 +15,7 @@
 
 namespace mocap::motion {
 
-enum class Family { cmu31, cmu_daz, bandai, generic };
+enum class Family { cmu31, cmu_asf, cmu_daz, bandai, generic };
 
 std::string_view family_name(Family f);
 

@@ -131,7 +131,7 @@ std::vector<ClipFrames> read_clips(const std::string& file, const BuildOptions& 
     c.info.name = path.filename().string();
     if (!out.empty()) c.info.name.append("#").append(std::to_string(out.size() + 1));  // a later run of the file
     c.info.source = path.string();
-    c.info.family = is_amc ? "asf_amc" : std::string(motion::family_name(mapping.family));
+    c.info.family = std::string(motion::family_name(mapping.family));
     c.info.mapping = mapping.notes;
     c.info.source_fps = clip.fps();
     c.info.source_first_frame = static_cast<std::uint32_t>(first);

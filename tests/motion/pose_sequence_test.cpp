@@ -3,7 +3,9 @@
 #include <gtest/gtest.h>
 
 #include "motion/body_mapping.hpp"
+#include "motion/asf_amc.hpp"
 #include "motion/bvh.hpp"
+#include "cmu_asf_fixture.hpp"
 #include "support/shared_data.hpp"
 
 namespace mocap::motion {
@@ -117,6 +119,22 @@ TEST(BodyMapping, EveryFamilyGivesAPlausibleBody) {
   expect_plausible_body("mocap/cmu31/86_01.bvh", Family::cmu31, 10);
   expect_plausible_body("mocap/cmu_daz/07_01.bvh", Family::cmu_daz, 10);
   expect_plausible_body("mocap/bandai/dataset-1/dataset-1_walk_normal_001.bvh", Family::bandai, 10);
+}
+
+TEST(BodyMapping, CmuAsfAmcIsRecognisedAndScaledToMetres) {
+  const AsfSkeleton asf = parse_asf(test::cmu_like_asf(), "cmu_like.asf");
+  const Clip clip = parse_amc(asf, test::cmu_like_amc(3), "cmu_like.amc", kCmuFps);
+  const BodyMapping m = map_to_body(clip.skeleton, "cmu_like.asf");
+  EXPECT_EQ(m.family, Family::cmu_asf);
+  const PoseSequence p = to_poses(clip);
+  GlobalPose g;
+  forward_kinematics(p, 0, g);
+  std::array<glm::vec3, kBodyJoints> b;
+  body_positions(m, g, b);
+  // Femur length 7.2 ASF units = 0.406 m; the head top is above the neck, the left hand on +X.
+  EXPECT_NEAR(glm::distance(b[index(Joint::left_hip)], b[index(Joint::left_knee)]), 7.2f * 0.056444f, 1e-3);
+  EXPECT_GT(b[index(Joint::head)].y, b[index(Joint::neck)].y);
+  EXPECT_GT(b[index(Joint::left_wrist)].x, b[index(Joint::right_wrist)].x);
 }
 
 TEST(BodyMapping, UnknownSkeletonNamesWhatIsMissing) {

@@ -10,6 +10,7 @@
 #include "posedb/builder.hpp"
 #include "posedb/cluster_search.hpp"
 #include "posedb/exact_search.hpp"
+#include "motion/cmu_asf_fixture.hpp"
 #include "support/shared_data.hpp"
 
 namespace mocap::posedb {
@@ -154,6 +155,33 @@ TEST(DatabaseFiles, CollectFindsBvhAndRejectsOthers) {
   EXPECT_EQ(files.size(), 5u);
   EXPECT_THROW(collect_motion_files({"/nonexistent/folder"}), InputError);
   EXPECT_THROW(collect_motion_files({(test::shared_data() / "mocap/README.md").string()}), InputError);
+}
+
+}  // namespace
+}  // namespace mocap::posedb
+
+namespace mocap::posedb {
+namespace {
+
+// A folder of CMU-style ASF/AMC files builds like BVH: the .amc finds its subject's .asf.
+TEST(DatabaseFiles, AsfAmcFolderBuilds) {
+  test::TempDir dir;
+  std::filesystem::create_directories(dir.path() / "42");
+  std::ofstream(dir.path() / "42" / "42.asf") << test::cmu_like_asf();
+  std::ofstream(dir.path() / "42" / "42_01.amc") << test::cmu_like_amc(240);
+  std::ofstream(dir.path() / "42" / "42_02.amc") << "garbage\n";
+  const auto files = collect_motion_files({dir.path().string()});
+  ASSERT_EQ(files.size(), 2u);
+  BuildOptions options;
+  options.clusters = 8;
+  BuildReport report;
+  const DatabaseContents db = build_database(files, options, {}, report);
+  ASSERT_EQ(report.skipped.size(), 1u);
+  EXPECT_NE(report.skipped[0].find("42_02.amc"), std::string::npos) << report.skipped[0];
+  ASSERT_EQ(db.clips.size(), 1u);
+  EXPECT_EQ(db.clips[0].family, "cmu_asf");
+  EXPECT_EQ(db.clips[0].frame_count, 48u);  // 240 frames at 120 fps -> 48 at 24 fps
+  EXPECT_EQ(db.projection_records.size(), 48u * 120u);
 }
 
 }  // namespace
