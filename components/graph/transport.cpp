@@ -20,6 +20,7 @@ struct TransportContext::Impl {
 
 TransportContext::TransportContext() : impl_(std::make_unique<Impl>()) {}
 TransportContext::~TransportContext() = default;
+void* TransportContext::native_handle() { return impl_->context.handle(); }
 
 namespace {
 

@@ -27,6 +27,7 @@ class TransportContext {
 
   struct Impl;
   Impl& impl() { return *impl_; }
+  void* native_handle();  // the zmq context (void*), for tests that speak raw ZeroMQ
 
  private:
   std::unique_ptr<Impl> impl_;
