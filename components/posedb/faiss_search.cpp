@@ -92,11 +92,13 @@ struct FaissSearch::Impl {
 FaissSearch::FaissSearch(MatrixView data, const FaissOptions& options)
     : impl_(std::make_unique<Impl>(Impl{data, options, {}})) {
   check_matrix(data, "FAISS search");
-  set_nprobe(options.nprobe);
+  set_nprobe(options.nprobe);  // rejects bad knobs before a long build
   set_ef_search(options.ef_search);
   impl_->options.nlist = static_cast<int>(
       std::min<std::size_t>(std::max(options.nlist, 1), std::max<std::size_t>(data.rows, 1)));
   impl_->built = build_index(data, impl_->options);
+  set_nprobe(options.nprobe);  // again, now that there is an index to apply them to
+  set_ef_search(options.ef_search);
 }
 
 FaissSearch::~FaissSearch() = default;
@@ -118,14 +120,22 @@ std::string FaissSearch::name() const {
   return "faiss";
 }
 
+// The knobs are written into the index itself: FAISS 1.7.3's HNSW ignores the efSearch of a
+// SearchParametersHNSW passed to search() (measured: recall and latency did not move).
 void FaissSearch::set_nprobe(int nprobe) {
   if (nprobe < 1) throw std::invalid_argument("FAISS search: nprobe must be at least 1");
   impl_->options.nprobe = nprobe;
+  if (auto* ivf = dynamic_cast<faiss::IndexIVF*>(impl_->built.index.get())) {
+    ivf->nprobe = static_cast<std::size_t>(nprobe);
+  }
 }
 
 void FaissSearch::set_ef_search(int ef_search) {
   if (ef_search < 1) throw std::invalid_argument("FAISS search: efSearch must be at least 1");
   impl_->options.ef_search = ef_search;
+  if (auto* hnsw = dynamic_cast<faiss::IndexHNSW*>(impl_->built.index.get())) {
+    hnsw->hnsw.efSearch = ef_search;
+  }
 }
 
 std::size_t FaissSearch::memory_bytes() const {
@@ -156,16 +166,9 @@ void FaissSearch::search(const float* query, const float* weights, int k,
   thread_local std::vector<FaissCount> labels;
   distances.resize(wanted);
   labels.resize(wanted);
-  faiss::SearchParametersIVF ivf_params;
-  ivf_params.nprobe = static_cast<std::size_t>(impl_->options.nprobe);
-  faiss::SearchParametersHNSW hnsw_params;
-  hnsw_params.efSearch = impl_->options.ef_search;
-  const faiss::SearchParameters* params = nullptr;
-  if (impl_->options.type == FaissIndexType::ivf_flat) params = &ivf_params;
-  if (impl_->options.type == FaissIndexType::hnsw_flat) params = &hnsw_params;
 
   impl_->built.index->search(1, query, static_cast<FaissCount>(wanted), distances.data(),
-                             labels.data(), params);
+                             labels.data());
   for (std::size_t i = 0; i < wanted; ++i) {
     if (labels[i] >= 0) out.push_back({static_cast<std::uint32_t>(labels[i]), distances[i]});
   }
