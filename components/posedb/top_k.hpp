@@ -27,7 +27,8 @@ class TopK {
 
   // Candidates farther than this can be skipped without calling offer().
   float bound() const {
-    return heap_.size() < k_ ? std::numeric_limits<float>::infinity() : heap_.front().distance;
+    if (heap_.size() < k_) return std::numeric_limits<float>::infinity();
+    return k_ == 0 ? -std::numeric_limits<float>::infinity() : heap_.front().distance;
   }
 
   void offer(std::uint32_t index, float distance) {
