@@ -1,7 +1,10 @@
 // `mocap-bench-search`: the search benchmark on synthetic pose-like data, so that it runs without
-// a database. Rows are Gaussian blobs of different widths in 28 dimensions (14 joints x (x, y),
-// values within about [-1, 1]); noisy queries add detector-like jitter to fresh draws.
+// a database. Poses of a body have few degrees of freedom, so the rows lie near a smooth
+// low-dimensional manifold in 28 dimensions (14 joints x (x, y), values within about [-1, 1]):
+// here a random smooth map of a `latent`-dimensional cube, with a little noise. Noisy queries add
+// detector-like jitter to fresh draws.
 
+#include <cmath>
 #include <exception>
 #include <iostream>
 #include <random>
@@ -17,37 +20,42 @@ namespace {
 
 constexpr int kPoseDim = 28;
 
-struct Blobs {
-  std::vector<float> centres;
-  std::vector<float> spreads;
+// x_j = 0.5 sin(a_j . z + b_j): smooth, bounded, and folded enough that no kd split is trivial.
+class PoseManifold {
+ public:
+  PoseManifold(int latent_dims, std::mt19937& rng)
+      : latent_(latent_dims), slope_(static_cast<std::size_t>(latent_dims) * kPoseDim) {
+    std::normal_distribution<float> slope(0.0f, 1.2f);
+    std::uniform_real_distribution<float> phase(0.0f, 6.2831853f);
+    for (float& a : slope_) a = slope(rng);
+    for (float& b : phase_) b = phase(rng);
+  }
+
+  // Appends one pose: a random latent point mapped to 28 values, plus `jitter` per value.
+  void draw(float jitter, std::mt19937& rng, std::vector<float>& out) const {
+    std::uniform_real_distribution<float> latent(-1.0f, 1.0f);
+    std::normal_distribution<float> noise(0.0f, 1.0f);
+    std::vector<float> z(static_cast<std::size_t>(latent_));
+    for (float& v : z) v = latent(rng);
+    for (int j = 0; j < kPoseDim; ++j) {
+      float angle = phase_[j];
+      for (int l = 0; l < latent_; ++l)
+        angle += slope_[static_cast<std::size_t>(j) * latent_ + l] * z[l];
+      out.push_back(0.5f * std::sin(angle) + kRowNoise * noise(rng) + jitter * noise(rng));
+    }
+  }
+
+ private:
+  static constexpr float kRowNoise = 0.005f;
+  int latent_;
+  std::vector<float> slope_;
+  float phase_[kPoseDim];
 };
 
-Blobs make_blobs(int count, std::mt19937& rng) {
-  std::uniform_real_distribution<float> value(-0.7f, 0.7f);
-  std::uniform_real_distribution<float> spread(0.03f, 0.12f);
-  Blobs blobs;
-  blobs.centres.resize(static_cast<std::size_t>(count) * kPoseDim);
-  for (float& v : blobs.centres) v = value(rng);
-  blobs.spreads.resize(static_cast<std::size_t>(count));
-  for (float& s : blobs.spreads) s = spread(rng);
-  return blobs;
-}
-
-// One draw: a random blob's centre plus its noise, plus extra jitter (0 for database rows).
-void draw(const Blobs& blobs, float jitter, std::mt19937& rng, std::vector<float>& out) {
-  std::uniform_int_distribution<std::size_t> pick(0, blobs.spreads.size() - 1);
-  std::normal_distribution<float> unit(0.0f, 1.0f);
-  const std::size_t b = pick(rng);
-  for (int j = 0; j < kPoseDim; ++j) {
-    out.push_back(blobs.centres[b * kPoseDim + j] + blobs.spreads[b] * unit(rng) +
-                  jitter * unit(rng));
-  }
-}
-
-std::vector<std::vector<float>> make_queries(const Blobs& blobs, long count, float jitter,
+std::vector<std::vector<float>> make_queries(const PoseManifold& poses, long count, float jitter,
                                              std::mt19937& rng) {
   std::vector<std::vector<float>> queries(static_cast<std::size_t>(count));
-  for (auto& q : queries) draw(blobs, jitter, rng, q);
+  for (auto& q : queries) poses.draw(jitter, rng, q);
   return queries;
 }
 
@@ -71,7 +79,7 @@ mocap::cli::Args declare_options() {
                         "Benchmarks exact, cluster, FLANN and FAISS search on synthetic poses.");
   args.option("rows", "N", "database rows", "200000")
       .option("queries", "N", "queries per set (clean and noisy)", "200")
-      .option("blobs", "N", "pose clusters in the synthetic data", "2000")
+      .option("latent", "N", "degrees of freedom of the synthetic poses", "8")
       .option("noise", "SIGMA", "jitter added to the noisy queries", "0.03")
       .option("k", "K", "neighbours per query", "10")
       .option("repeats", "N", "interleaved timing passes", "5")
@@ -115,14 +123,14 @@ int run(int argc, char** argv) {
   const mocap::bench::SearchBenchOptions options = bench_options(args);
 
   std::mt19937 rng(static_cast<std::uint32_t>(options.seed));
-  const Blobs blobs = make_blobs(static_cast<int>(args.integer("blobs")), rng);
+  const PoseManifold poses(static_cast<int>(args.integer("latent")), rng);
   const auto rows = static_cast<std::size_t>(args.integer("rows"));
   std::vector<float> data;
   data.reserve(rows * kPoseDim);
-  for (std::size_t i = 0; i < rows; ++i) draw(blobs, 0.0f, rng, data);
+  for (std::size_t i = 0; i < rows; ++i) poses.draw(0.0f, rng, data);
   const long queries = args.integer("queries");
-  const auto clean = make_queries(blobs, queries, 0.0f, rng);
-  const auto noisy = make_queries(blobs, queries, static_cast<float>(args.number("noise")), rng);
+  const auto clean = make_queries(poses, queries, 0.0f, rng);
+  const auto noisy = make_queries(poses, queries, static_cast<float>(args.number("noise")), rng);
 
   mocap::bench::run_search_benchmark({data.data(), rows, kPoseDim}, clean, noisy, std::cout,
                                      options);
