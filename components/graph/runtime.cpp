@@ -14,6 +14,8 @@
 namespace mocap::graph {
 
 using Clock = std::chrono::steady_clock;
+constexpr auto kRepeatEndOfStream = std::chrono::milliseconds(500);
+constexpr auto kAcknowledgementTimeout = std::chrono::milliseconds(30000);
 
 class NodeRunner;
 
@@ -89,6 +91,8 @@ struct Runtime::Impl {
   NodeRunner* runner(std::string_view name) const;
   void receive_loop(IncomingEdge& edge);
   GraphStats snapshot() const;
+  void join_nodes();
+  void wait_for_acknowledgements();
 
   ResolvedGraph graph;
   RunOptions options;
@@ -141,6 +145,21 @@ class NodeRunner final : public Context {
   }
   void join() {
     if (thread_.joinable()) thread_.join();
+  }
+  bool finished() const { return thread_finished_; }
+
+  // After the node ended (and its thread was joined): repeats the end of stream on every ZeroMQ
+  // output, without waiting, for a consumer that restarted after the first one. Returns true when
+  // every consumer has acknowledged an end of stream at least once.
+  bool repeat_end_of_stream(bool resend) {
+    bool all_acknowledged = true;
+    for (Output& out : outputs_) {
+      for (RemoteOutput& remote : out.remote) {
+        if (resend) remote.sender->send(Packet::end_of_stream(), [] { return true; });
+        all_acknowledged = remote.sender->poll_acknowledgement() && all_acknowledged;
+      }
+    }
+    return all_acknowledged;
   }
 
   NodeStats snapshot() const {
@@ -229,6 +248,7 @@ class NodeRunner final : public Context {
 
   std::atomic<std::uint64_t> in_{0}, out_{0}, own_drops_{0};
   std::atomic<int> state_{waiting};
+  std::atomic<bool> thread_finished_{false};
   LatencyWindow latency_;
 };
 
@@ -304,6 +324,7 @@ void NodeRunner::run() {
   end_outputs();
   state_ = failed_ ? failed : done;
   runtime_.node_finished(blocks_auxiliary_);
+  thread_finished_ = true;
 }
 
 void NodeRunner::end_outputs() {
@@ -361,10 +382,9 @@ void Runtime::Impl::add_sending_half(const EdgeSpec& edge) {
   NodeRunner::Output& out = from->output(
       static_cast<std::size_t>(from->resolved().type->contract.output_index(edge.from.port)));
   if (uses_transport(edge)) {
-    out.remote.push_back(
-        {std::make_unique<Sender>(transport, edge.transport, Sender::Pattern::push_connect,
-                                  socket_options(edge)),
-         edge.policy.lossy()});
+    out.remote.push_back({std::make_unique<Sender>(transport, edge.transport, Sender::Pattern::edge,
+                                                   socket_options(edge)),
+                          edge.policy.lossy()});
     return;
   }
   if (!to) {
@@ -434,7 +454,54 @@ void Runtime::Impl::receive_loop(IncomingEdge& edge) {
     if (!result.message) continue;
     const bool eos = result.message->packet.is_end_of_stream();
     if (!edge.inbox->push(edge.port, std::move(result.message->packet))) return;  // consumer gone
-    if (eos) return;
+    if (eos) {
+      edge.receiver->acknowledge_end();
+      return;
+    }
+  }
+}
+
+// Joins node threads as they finish. Meanwhile, nodes that have ended keep repeating their end of
+// stream on ZeroMQ edges: a consumer process restarted by the supervisor after the first one
+// would otherwise wait for it forever.
+void Runtime::Impl::join_nodes() {
+  std::vector<bool> joined(runners.size(), false);
+  auto last_repeat = Clock::now();
+  for (std::size_t left = runners.size(); left > 0;) {
+    for (std::size_t i = 0; i < runners.size(); ++i) {
+      if (joined[i] || !runners[i]->finished()) continue;
+      runners[i]->join();
+      joined[i] = true;
+      --left;
+    }
+    const bool repeat = Clock::now() - last_repeat > kRepeatEndOfStream;
+    if (repeat) last_repeat = Clock::now();
+    for (std::size_t i = 0; i < runners.size(); ++i) {
+      if (joined[i]) runners[i]->repeat_end_of_stream(repeat);
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+}
+
+// Waits (bounded) until every consumer in another process has confirmed the end of stream, so
+// that closing the sockets cannot lose the last messages.
+void Runtime::Impl::wait_for_acknowledgements() {
+  const auto limit = stop_requested() ? options.drain_timeout : kAcknowledgementTimeout;
+  const auto deadline = Clock::now() + limit;
+  auto last_repeat = Clock::now();
+  while (true) {
+    const bool repeat = Clock::now() - last_repeat > kRepeatEndOfStream;
+    if (repeat) last_repeat = Clock::now();
+    bool all = true;
+    for (auto& r : runners) all = r->repeat_end_of_stream(repeat) && all;
+    if (all) return;
+    if (Clock::now() > deadline) {
+      log("warning: a consumer in another process did not confirm the end of stream within " +
+          std::to_string(std::chrono::duration_cast<std::chrono::milliseconds>(limit).count()) +
+          " ms; its last messages may be lost");
+      return;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
 }
 
@@ -471,9 +538,10 @@ RunResult Runtime::run() {
     e->thread = std::thread([this, e] { impl_->receive_loop(*e); });
   }
   for (auto& r : impl_->runners) r->start();
-  for (auto& r : impl_->runners) r->join();
+  impl_->join_nodes();
   impl_->receivers_done = true;
   for (auto& e : impl_->incoming) e->thread.join();
+  impl_->wait_for_acknowledgements();
   RunResult result;
   result.stats = impl_->snapshot();
   std::lock_guard lock(impl_->mutex);

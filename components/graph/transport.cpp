@@ -65,20 +65,20 @@ struct Sender::Impl {
 Sender::Sender(TransportContext& context, const std::string& endpoint, Pattern pattern,
                SocketOptions options)
     : endpoint_(endpoint) {
-  const auto type = pattern == Pattern::push_connect   ? zmq::socket_type::push
+  const auto type = pattern == Pattern::edge           ? zmq::socket_type::dealer
                     : pattern == Pattern::publish_bind ? zmq::socket_type::pub
                                                        : zmq::socket_type::xpub;
   impl_ = std::make_unique<Impl>(Impl{zmq::socket_t(context.impl().context, type), pattern});
   configure(impl_->socket, options);
   impl_->socket.set(zmq::sockopt::sndtimeo, 50);
   try {
-    if (pattern == Pattern::push_connect) {
+    if (pattern == Pattern::edge) {
       impl_->socket.connect(endpoint);
     } else {
       impl_->socket.bind(endpoint);
     }
   } catch (const zmq::error_t& e) {
-    throw endpoint_error(pattern == Pattern::push_connect ? "connect to" : "bind", endpoint, e);
+    throw endpoint_error(pattern == Pattern::edge ? "connect to" : "bind", endpoint, e);
   }
 }
 
@@ -93,7 +93,7 @@ bool Sender::send(const Packet& packet, const std::function<bool()>& give_up) {
   // the message follows without waiting.
   while (!impl_->socket.send(parts[0],
                              parts.size() > 1 ? zmq::send_flags::sndmore : zmq::send_flags::none)) {
-    if (impl_->pattern != Pattern::push_connect) return false;  // PUB never waits; nothing to do
+    if (impl_->pattern != Pattern::edge) return false;  // PUB never waits; nothing to do
     if (give_up && give_up()) return false;
   }
   for (std::size_t i = 1; i < parts.size(); ++i) {
@@ -101,6 +101,15 @@ bool Sender::send(const Packet& packet, const std::function<bool()>& give_up) {
                        i + 1 < parts.size() ? zmq::send_flags::sndmore : zmq::send_flags::none);
   }
   return true;
+}
+
+bool Sender::poll_acknowledgement() {
+  if (impl_->pattern != Pattern::edge) return true;
+  zmq::message_t reply;
+  while (impl_->socket.recv(reply, zmq::recv_flags::dontwait)) {
+    if (reply.to_string_view() == wire::kEndAcknowledgement) acknowledged_ = true;
+  }
+  return acknowledged_;
 }
 
 bool Sender::wait_for_subscriber(std::chrono::milliseconds timeout) {
@@ -125,7 +134,7 @@ struct Receiver::Impl {
 Receiver::Receiver(TransportContext& context, const std::string& endpoint, SocketOptions options)
     : endpoint_(endpoint) {
   impl_ =
-      std::make_unique<Impl>(Impl{zmq::socket_t(context.impl().context, zmq::socket_type::pull)});
+      std::make_unique<Impl>(Impl{zmq::socket_t(context.impl().context, zmq::socket_type::dealer)});
   configure(impl_->socket, options);
   try {
     impl_->socket.bind(endpoint);
@@ -135,6 +144,12 @@ Receiver::Receiver(TransportContext& context, const std::string& endpoint, Socke
 }
 
 Receiver::~Receiver() = default;
+
+void Receiver::acknowledge_end() {
+  // Never waits: a producer that is gone (or restarting) simply does not get it.
+  zmq::message_t ack(wire::kEndAcknowledgement.data(), wire::kEndAcknowledgement.size());
+  [[maybe_unused]] auto sent = impl_->socket.send(ack, zmq::send_flags::dontwait);
+}
 
 Receiver::Result Receiver::receive(std::chrono::milliseconds timeout) {
   zmq::pollitem_t item{impl_->socket.handle(), 0, ZMQ_POLLIN, 0};

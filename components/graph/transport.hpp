@@ -1,8 +1,9 @@
 #pragma once
 // ZeroMQ edges, behind a small interface so that no other file includes zmq.hpp. A Sender
-// connects a PUSH socket (or binds a PUB/XPUB socket for streams others subscribe to); a Receiver
-// binds a PULL socket. Messages are encoded in the wire format (wire_format.hpp); large frames
-// (images) are handed to ZeroMQ without a copy on both sides.
+// connects a DEALER socket (or binds a PUB/XPUB socket for streams others subscribe to); a Receiver
+// binds a DEALER socket (DEALER pairs, so
+// the consumer can acknowledge the end of stream). Messages are encoded in the wire format
+// (wire_format.hpp); large frames (images) are handed to ZeroMQ without a copy on both sides.
 // Shutdown never hangs: every socket has a bounded linger, sends wait in short slices and ask
 // whether to give up, receives poll with a timeout.
 
@@ -42,7 +43,7 @@ struct SocketOptions {
 class Sender {
  public:
   enum class Pattern {
-    push_connect,   // one consumer, backpressure: the edge transport
+    edge,           // DEALER, connects: one consumer, backpressure, end-of-stream acknowledged
     publish_bind,   // any number of subscribers, never waits (drops when they lag)
     xpublish_bind,  // like publish_bind, and wait_for_subscriber() works
   };
@@ -56,6 +57,10 @@ class Sender {
   // Sends one message. While the peer's queue is full it waits in 50 ms slices, calling
   // `give_up` between them; returns false (message not sent) when it does.
   bool send(const Packet& packet, const std::function<bool()>& give_up = {});
+  // Pattern::edge: true once the consumer has confirmed an end of stream. Closing before that can
+  // lose the last messages (libzmq drops what a full receiver has not yet queued when the peer
+  // disconnects), so producers wait for it, bounded, before they exit.
+  bool poll_acknowledgement();
   // xpublish_bind: waits until at least one subscriber has subscribed.
   bool wait_for_subscriber(std::chrono::milliseconds timeout);
   const std::string& endpoint() const { return endpoint_; }
@@ -64,6 +69,7 @@ class Sender {
   struct Impl;
   std::unique_ptr<Impl> impl_;
   std::string endpoint_;
+  bool acknowledged_ = false;
 };
 
 class Receiver {
@@ -79,6 +85,8 @@ class Receiver {
   };
   // Waits up to `timeout`; both fields empty when nothing arrived.
   Result receive(std::chrono::milliseconds timeout);
+  // Tells the producer that its end of stream arrived (see Sender::poll_acknowledgement).
+  void acknowledge_end();
   const std::string& endpoint() const { return endpoint_; }
 
  private:

@@ -10,6 +10,7 @@
 #include <span>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "graph/packet.hpp"
@@ -20,6 +21,9 @@ inline constexpr std::uint16_t kVersion = 1;
 inline constexpr char kMagic[4] = {'M', 'O', 'C', 'P'};
 inline constexpr std::size_t kHeaderBytes = 44;  // without the stream id
 inline constexpr std::size_t kMaxFrames = 8;     // no message type has more payload frames
+
+// Sent back by the consumer of an edge once its end of stream arrived (a one-frame message).
+inline constexpr std::string_view kEndAcknowledgement = "MOCP-END-ACK";
 
 enum class TypeCode : std::uint16_t {
   end_of_stream = 0,

@@ -48,7 +48,7 @@ TEST_P(Transport, MessagesArriveInOrderWithImagesIntact) {
   TransportContext context;
   const std::string where = endpoint(GetParam(), dir);
   Receiver receiver(context, where);
-  Sender sender(context, where, Sender::Pattern::push_connect);
+  Sender sender(context, where, Sender::Pattern::edge);
   constexpr int kMessages = 1000;
   std::thread producer([&] {
     for (int i = 0; i < kMessages; ++i)
@@ -80,7 +80,7 @@ TEST_P(Transport, GarbageOnTheSocketIsRejectedAndValidMessagesStillPass) {
   const std::string where = endpoint(GetParam(), dir);
   Receiver receiver(context, where);
   // A foreign program that speaks ZeroMQ but not our format.
-  void* raw = zmq_socket(context.native_handle(), ZMQ_PUSH);
+  void* raw = zmq_socket(context.native_handle(), ZMQ_DEALER);
   const int linger = 0;
   zmq_setsockopt(raw, ZMQ_LINGER, &linger, sizeof linger);
   ASSERT_EQ(zmq_connect(raw, where.c_str()), 0);

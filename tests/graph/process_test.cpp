@@ -1,0 +1,328 @@
+// End-to-end tests that drive the built `mocap` binary in real processes: one process versus two
+// (ipc:// and tcp://), SIGTERM, supervisor restarts, failures, validation messages, plugins and
+// garbage on a live socket. Every wait is bounded and every child is killed and reaped at the end.
+
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <zmq.h>
+
+#include <chrono>
+#include <cstring>
+#include <filesystem>
+#include <optional>
+#include <regex>
+#include <thread>
+
+#include "graph_test_util.hpp"
+
+extern char** environ;
+
+namespace mocap::graph {
+namespace {
+
+using namespace std::chrono_literals;
+using testing::TempDir;
+
+// A child process running `mocap ARGS...` with stdout and stderr going to files.
+class Mocap {
+ public:
+  Mocap(const TempDir& dir, const std::string& name, std::vector<std::string> args,
+        std::vector<std::string> extra_env = {})
+      : out_(dir.file(name + ".out")), err_(dir.file(name + ".err")) {
+    args.insert(args.begin(), MOCAP_BINARY);
+    std::vector<char*> argv;
+    for (auto& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    std::vector<std::string> env;
+    for (char** e = environ; *e; ++e) {
+      if (std::strncmp(*e, "MOCAP_", 6) != 0) env.emplace_back(*e);  // no inherited plugin path
+    }
+    env.insert(env.end(), extra_env.begin(), extra_env.end());
+    std::vector<char*> envp;
+    for (auto& e : env) envp.push_back(e.data());
+    envp.push_back(nullptr);
+    posix_spawn_file_actions_t files;
+    posix_spawn_file_actions_init(&files);
+    posix_spawn_file_actions_addopen(&files, 1, out_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    posix_spawn_file_actions_addopen(&files, 2, err_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    const int error = posix_spawn(&pid_, MOCAP_BINARY, &files, nullptr, argv.data(), envp.data());
+    posix_spawn_file_actions_destroy(&files);
+    if (error != 0)
+      throw std::runtime_error(std::string("cannot start mocap: ") + std::strerror(error));
+  }
+  ~Mocap() {
+    if (pid_ > 0) {
+      kill(pid_, SIGKILL);  // its children follow (PR_SET_PDEATHSIG)
+      waitpid(pid_, nullptr, 0);
+    }
+  }
+  Mocap(const Mocap&) = delete;
+  Mocap& operator=(const Mocap&) = delete;
+
+  pid_t pid() const { return pid_; }
+  // The exit code (128 + signal when killed), or nullopt after `timeout` (the process is killed).
+  std::optional<int> wait(std::chrono::milliseconds timeout) {
+    const auto deadline = std::chrono::steady_clock::now() + timeout;
+    while (std::chrono::steady_clock::now() < deadline) {
+      int status = 0;
+      if (waitpid(pid_, &status, WNOHANG) == pid_) {
+        pid_ = -1;
+        return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+      }
+      std::this_thread::sleep_for(20ms);
+    }
+    return std::nullopt;
+  }
+  std::string err() const { return testing::read_file(err_); }
+  std::string out() const { return testing::read_file(out_); }
+  // Waits until stderr matches `pattern`; returns the first capture group (or "").
+  std::optional<std::string> wait_for_log(const std::string& pattern,
+                                          std::chrono::milliseconds timeout,
+                                          std::size_t occurrence = 1) const {
+    const std::regex re(pattern);
+    const auto deadline = std::chrono::steady_clock::now() + timeout;
+    while (std::chrono::steady_clock::now() < deadline) {
+      const std::string text = err();
+      std::size_t seen = 0;
+      for (auto it = std::sregex_iterator(text.begin(), text.end(), re);
+           it != std::sregex_iterator(); ++it) {
+        if (++seen == occurrence) return it->size() > 1 ? (*it)[1].str() : std::string();
+      }
+      std::this_thread::sleep_for(20ms);
+    }
+    return std::nullopt;
+  }
+
+ private:
+  std::string out_, err_;
+  pid_t pid_ = -1;
+};
+
+std::string endpoint(const std::string& kind, const TempDir& dir, const std::string& name) {
+  if (kind == "ipc") return "ipc://" + dir.file(name);
+  return "tcp://127.0.0.1:" + std::to_string(testing::free_tcp_port());
+}
+
+// Counter and frames in process `capture`, their consumers in `solve`.
+std::string split_graph(const TempDir& dir, const std::string& kind, long count,
+                        double interval_ms) {
+  return "graph: split\nnodes:\n"
+         "  src:    { type: test.counter, params: { count: " +
+         std::to_string(count) + ", interval_ms: " + std::to_string(interval_ms) +
+         ", people: 2 } }\n"
+         "  cam:    { type: test.frames, params: { count: 10, width: 320, height: 240 } }\n"
+         "  pass:   { type: flow.pass_through }\n"
+         "  sink:   { type: test.collect, params: { path: " +
+         dir.file("sink.txt") +
+         " } }\n"
+         "  images: { type: test.collect, params: { path: " +
+         dir.file("images.txt") +
+         " } }\n"
+         "edges:\n"
+         "  - [src.out, pass.in, { transport: \"" +
+         endpoint(kind, dir, "people") +
+         "\" }]\n"
+         "  - [pass.out, sink.in]\n"
+         "  - [cam.frames, images.in, { transport: \"" +
+         endpoint(kind, dir, "frames") +
+         "\", policy: blocking(2) }]\n"
+         "processes:\n  capture: [src, cam]\n  solve: [pass, sink, images]\n";
+}
+
+void expect_contiguous_from_zero(const std::vector<std::string>& lines) {
+  for (std::size_t i = 0; i < lines.size(); ++i) {
+    ASSERT_EQ(testing::fields(lines[i])[1], std::to_string(i)) << "line " << i;
+  }
+}
+
+class SplitGraph : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(SplitGraph, SameGraphInOneProcessAndSplitOverTwoGivesIdenticalOutputs) {
+  TempDir dir;
+  const std::string graph = dir.file("g.yaml");
+  testing::write_file(graph, split_graph(dir, GetParam(), 1000, 0));
+  Mocap single(dir, "single",
+               {"run", graph, "--single-process", "--set", "sink.path=" + dir.file("one.txt"),
+                "--set", "images.path=" + dir.file("one-images.txt")});
+  ASSERT_EQ(single.wait(60s), 0) << single.err();
+  Mocap split(dir, "split",
+              {"run", graph, "--set", "sink.path=" + dir.file("two.txt"), "--set",
+               "images.path=" + dir.file("two-images.txt")});
+  ASSERT_EQ(split.wait(60s), 0) << split.err();
+  EXPECT_NE(split.err().find("started group 'solve'"), std::string::npos);  // really two processes
+  EXPECT_EQ(testing::read_lines(dir.file("one.txt")).size(), 1000u);
+  EXPECT_EQ(testing::read_file(dir.file("one.txt")), testing::read_file(dir.file("two.txt")));
+  EXPECT_EQ(testing::read_lines(dir.file("one-images.txt")).size(), 10u);
+  EXPECT_EQ(testing::read_file(dir.file("one-images.txt")),
+            testing::read_file(dir.file("two-images.txt")));
+}
+
+TEST_P(SplitGraph, SigtermToTheSupervisorDrainsEveryGroupAndExitsZero) {
+  TempDir dir;
+  const std::string graph = dir.file("g.yaml");
+  testing::write_file(graph, split_graph(dir, GetParam(), 0, 2));
+  Mocap run(dir, "run", {"run", graph});
+  ASSERT_TRUE(run.wait_for_log("started group 'solve'", 20s)) << run.err();
+  std::this_thread::sleep_for(1s);
+  kill(run.pid(), SIGTERM);
+  ASSERT_EQ(run.wait(60s), 0) << run.err();
+  const auto lines = testing::read_lines(dir.file("sink.txt"));
+  EXPECT_GT(lines.size(), 5u);
+  expect_contiguous_from_zero(lines);
+}
+
+TEST_P(SplitGraph, KillingOneProcessOfASupervisedGraphRestartsIt) {
+  TempDir dir;
+  const std::string graph = dir.file("g.yaml");
+  testing::write_file(graph, split_graph(dir, GetParam(), 1500, 2));
+  Mocap run(dir, "run", {"run", graph});
+  const auto pid = run.wait_for_log(R"(started group 'solve' \(pid (\d+)\))", 20s);
+  ASSERT_TRUE(pid) << run.err();
+  std::this_thread::sleep_for(500ms);
+  ASSERT_EQ(kill(std::stoi(*pid), SIGKILL), 0);
+  ASSERT_TRUE(run.wait_for_log("group 'solve' killed by signal 9; restarting", 20s)) << run.err();
+  ASSERT_TRUE(run.wait_for_log("started group 'solve'", 20s, 2)) << run.err();
+  ASSERT_EQ(run.wait(90s), 0) << run.err();
+  // The restarted group received the rest of the stream, through to the end.
+  const auto lines = testing::read_lines(dir.file("sink.txt"));
+  ASSERT_FALSE(lines.empty());
+  EXPECT_EQ(testing::fields(lines.back())[1], "1499");
+}
+
+INSTANTIATE_TEST_SUITE_P(IpcAndTcp, SplitGraph, ::testing::Values("ipc", "tcp"));
+
+TEST(Process, SigtermMidRunFlushesTheSinksAndExitsZero) {
+  TempDir dir;
+  const std::string graph = dir.file("g.yaml");
+  testing::write_file(
+      graph,
+      "nodes:\n  src: { type: test.counter, params: { count: 0, interval_ms: 2 } }\n"
+      "  slow: { type: test.delay, params: { delay_ms: 1 } }\n"
+      "  sink: { type: test.collect, params: { path: " +
+          dir.file("out.txt") +
+          " } }\n"
+          "edges:\n  - [src.out, slow.in, { policy: blocking(100) }]\n  - [slow.out, sink.in]\n");
+  Mocap run(dir, "run", {"run", graph});
+  std::this_thread::sleep_for(700ms);
+  kill(run.pid(), SIGTERM);
+  ASSERT_EQ(run.wait(30s), 0) << run.err();
+  EXPECT_NE(run.err().find("stopping: draining"), std::string::npos) << run.err();
+  const auto lines = testing::read_lines(dir.file("out.txt"));
+  EXPECT_GT(lines.size(), 10u);
+  expect_contiguous_from_zero(lines);
+}
+
+TEST(Process, NodeFailureExitsNonZeroNamingTheNode) {
+  TempDir dir;
+  const std::string graph = dir.file("g.yaml");
+  testing::write_file(graph,
+                      "nodes:\n  src: { type: test.counter, params: { count: 100 } }\n"
+                      "  boom: { type: test.fail, params: { after: 3 } }\n"
+                      "  sink: { type: test.collect, params: { path: " +
+                          dir.file("out.txt") +
+                          " } }\n"
+                          "edges:\n  - [src.out, boom.in]\n  - [boom.out, sink.in]\n");
+  Mocap run(dir, "run", {"run", graph});
+  ASSERT_EQ(run.wait(30s), 1) << run.err();
+  EXPECT_NE(run.err().find("node 'boom' (test.fail) failed"), std::string::npos) << run.err();
+  EXPECT_EQ(testing::read_lines(dir.file("out.txt")).size(), 3u);
+}
+
+TEST(Process, GraphValidateInspectAndDot) {
+  TempDir dir;
+  const std::string bad = dir.file("bad.yaml");
+  testing::write_file(bad,
+                      "graph: bad\nnodes:\n  a: { type: no.such }\n  b: { type: test.counter, "
+                      "params: { count: x } }\n");
+  Mocap validate_bad(dir, "validate-bad", {"graph", "validate", bad});
+  ASSERT_EQ(validate_bad.wait(30s), 1);
+  EXPECT_NE(validate_bad.err().find(bad + ":3: node 'a': unknown node type 'no.such'"),
+            std::string::npos)
+      << validate_bad.err();
+  EXPECT_NE(validate_bad.err().find(bad + ":4: node 'b': parameter 'count'"), std::string::npos)
+      << validate_bad.err();
+
+  const std::string good = dir.file("good.yaml");
+  testing::write_file(good, split_graph(dir, "ipc", 10, 0));
+  Mocap validate_good(dir, "validate-good", {"graph", "validate", good});
+  ASSERT_EQ(validate_good.wait(30s), 0) << validate_good.err();
+  EXPECT_NE(validate_good.out().find("ok (5 nodes, 3 edges, 2 processes)"), std::string::npos);
+
+  Mocap inspect(dir, "inspect", {"graph", "inspect"});
+  ASSERT_EQ(inspect.wait(30s), 0);
+  EXPECT_NE(inspect.out().find("flow.limiter"), std::string::npos);
+  Mocap inspect_one(dir, "inspect-one", {"graph", "inspect", "test.collect"});
+  ASSERT_EQ(inspect_one.wait(30s), 0);
+  EXPECT_NE(inspect_one.out().find("path : string (required)"), std::string::npos)
+      << inspect_one.out();
+  Mocap inspect_unknown(dir, "inspect-unknown", {"graph", "inspect", "no.such"});
+  EXPECT_EQ(inspect_unknown.wait(30s), 1);
+
+  Mocap dot(dir, "dot", {"graph", "dot", good});
+  ASSERT_EQ(dot.wait(30s), 0);
+  EXPECT_NE(dot.out().find("subgraph \"cluster_capture\""), std::string::npos) << dot.out();
+  EXPECT_NE(dot.out().find("\"src\" -> \"pass\""), std::string::npos) << dot.out();
+}
+
+TEST(Process, PluginFromThePluginPathAndFromTheGraphFile) {
+  TempDir dir;
+  const std::string plugin = MOCAP_TEST_PLUGIN;
+  const std::string body =
+      "nodes:\n  src: { type: test.counter, params: { count: 4 } }\n"
+      "  tag: { type: plugin.tag, params: { stream: from_plugin } }\n"
+      "  sink: { type: test.collect, params: { path: " +
+      dir.file("out.txt") +
+      " } }\n"
+      "edges:\n  - [src.out, tag.in]\n  - [tag.out, sink.in]\n";
+  testing::write_file(dir.file("env.yaml"), body);
+  testing::write_file(dir.file("key.yaml"), body + "plugins: [" + plugin + "]\n");
+
+  Mocap without(dir, "without", {"graph", "validate", dir.file("env.yaml")});
+  ASSERT_EQ(without.wait(30s), 1);
+  EXPECT_NE(without.err().find("unknown node type 'plugin.tag'"), std::string::npos)
+      << without.err();
+
+  const std::string plugin_dir = std::filesystem::path(plugin).parent_path().string();
+  Mocap from_env(dir, "env", {"run", dir.file("env.yaml")},
+                 {"MOCAP_PLUGIN_PATH=/nonexistent:" + plugin_dir});
+  ASSERT_EQ(from_env.wait(30s), 0) << from_env.err();
+  auto lines = testing::read_lines(dir.file("out.txt"));
+  ASSERT_EQ(lines.size(), 4u);
+  EXPECT_EQ(testing::fields(lines[0])[0], "from_plugin");
+
+  std::filesystem::remove(dir.file("out.txt"));
+  Mocap from_key(dir, "key", {"run", dir.file("key.yaml")});
+  ASSERT_EQ(from_key.wait(30s), 0) << from_key.err();
+  EXPECT_EQ(testing::read_lines(dir.file("out.txt")).size(), 4u);
+}
+
+TEST(Process, GarbageSentToARunningGraphIsRejectedWithAMessage) {
+  TempDir dir;
+  const std::string graph = dir.file("g.yaml");
+  testing::write_file(graph, split_graph(dir, "ipc", 50, 0));
+  Mocap solve(dir, "solve", {"run", graph, "--process", "solve"});
+  // Speak ZeroMQ to its people edge, but not the wire format.
+  void* context = zmq_ctx_new();
+  void* raw = zmq_socket(context, ZMQ_DEALER);
+  const int linger = 2000;
+  zmq_setsockopt(raw, ZMQ_LINGER, &linger, sizeof linger);
+  ASSERT_EQ(zmq_connect(raw, ("ipc://" + dir.file("people")).c_str()), 0);
+  for (const char* junk :
+       {"hello", "MOCP\x02\x00garbage-with-a-plausible-start-but-version-2-and-too-short"}) {
+    zmq_send(raw, junk, std::strlen(junk), 0);
+  }
+  zmq_close(raw);
+  zmq_ctx_term(context);
+  ASSERT_TRUE(solve.wait_for_log("rejected a malformed message \\(2 so far\\)", 20s))
+      << solve.err();
+  Mocap capture(dir, "capture", {"run", graph, "--process", "capture"});
+  ASSERT_EQ(capture.wait(30s), 0) << capture.err();
+  ASSERT_EQ(solve.wait(30s), 0) << solve.err();
+  EXPECT_EQ(testing::read_lines(dir.file("sink.txt")).size(), 50u);
+}
+
+}  // namespace
+}  // namespace mocap::graph
