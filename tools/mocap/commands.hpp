@@ -7,5 +7,6 @@ namespace mocap::cli {
 int db_command(int argc, char** argv);
 int run_command(int argc, char** argv);
 int graph_command(int argc, char** argv);
+int eval_command(int argc, char** argv);
 
 }  // namespace mocap::cli

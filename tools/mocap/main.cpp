@@ -18,6 +18,7 @@ constexpr Command kCommands[] = {
     {"db", "build, inspect and query the 2D-projection pose database", mocap::cli::db_command},
     {"run", "run a graph file (nodes wired by YAML), in one or several processes", mocap::cli::run_command},
     {"graph", "validate a graph file, inspect node types, export Graphviz", mocap::cli::graph_command},
+    {"eval", "measure accuracy: virtual-video and HumanEva-I protocols", mocap::cli::eval_command},
 };
 
 void print_usage(std::ostream& out) {

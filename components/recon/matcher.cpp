@@ -1,0 +1,83 @@
+#include "recon/matcher.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "posedb/cluster_search.hpp"
+#include "posedb/exact_search.hpp"
+
+namespace mocap::recon {
+
+struct Matcher::Search {
+  std::unique_ptr<posedb::SearchIndex> index;
+  std::vector<posedb::Neighbor> neighbors;
+};
+
+Matcher::Matcher(const posedb::Database& db, const MatchOptions& options)
+    : db_(db), options_(options), search_(std::make_unique<Search>()) {
+  if (options.exact) {
+    search_->index = std::make_unique<posedb::ExactSearch>(db.projections());
+  } else {
+    search_->index = std::make_unique<posedb::ClusterSearch>(db.projections(), db.centroids(),
+                                                             db.cluster_begin(), options.probe);
+  }
+}
+
+Matcher::~Matcher() = default;
+Matcher::Matcher(Matcher&&) noexcept = default;
+
+namespace {
+
+// Height of the box around the rows' joints that have a weight (root at the origin included).
+float partial_height(const float* row, const posedb::PoseVector& weights) {
+  float lo = 0.0f, hi = 0.0f;
+  for (int j = 0; j < kBodyJoints - 1; ++j) {
+    if (weights[2 * j + 1] == 0.0f) continue;
+    lo = std::min(lo, row[2 * j + 1]);
+    hi = std::max(hi, row[2 * j + 1]);
+  }
+  return hi - lo;
+}
+
+}  // namespace
+
+// A partial body normalised by its own box is too large (the box of the visible joints is
+// smaller than the whole body's). After a first search the best candidate tells how tall that
+// partial box is in database units; the query is rescaled to it and searched again.
+bool Matcher::match(std::span<const float, kBodyJoints * 3> body, std::vector<Candidate>& out) {
+  out.clear();
+  std::array<glm::vec2, kBodyJoints> points;
+  int present = 0;
+  constexpr float nan = std::numeric_limits<float>::quiet_NaN();
+  for (int j = 0; j < kBodyJoints; ++j) {
+    const bool ok = body[3 * j + 2] >= options_.min_confidence && std::isfinite(body[3 * j]) &&
+                    std::isfinite(body[3 * j + 1]);
+    points[j] = ok ? glm::vec2(body[3 * j], body[3 * j + 1]) : glm::vec2(nan, nan);
+    present += ok ? 1 : 0;
+  }
+  if (present < options_.min_joints) return false;
+  posedb::PoseVector query, weights;
+  if (!posedb::normalize_pose(points, db_.build_info().scaling, query)) return false;
+  for (int d = 0; d < posedb::kPoseDims; ++d) weights[d] = std::isfinite(query[d]) ? 1.0f : 0.0f;
+
+  auto& found = search_->neighbors;
+  const bool partial =
+      present < kBodyJoints && db_.build_info().scaling == posedb::Scaling::bbox_height;
+  const int passes = partial ? 1 + options_.rescale_passes : 1;
+  for (int pass = 0; pass < passes; ++pass) {
+    search_->index->search(query.data(), weights.data(), options_.k, found);
+    if (found.empty() || pass + 1 == passes) break;
+    const float scale = partial_height(db_.projections().row(found.front().index), weights);
+    const float own = partial_height(query.data(), weights);
+    if (!(scale > 1e-4f) || !(own > 1e-4f)) break;
+    for (int d = 0; d < posedb::kPoseDims; ++d) query[d] *= scale / own;
+  }
+  const auto records = db_.projection_records();
+  for (const auto& n : found) {
+    out.push_back({n.index, records[n.index].frame, records[n.index].view, n.distance});
+  }
+  return !out.empty();
+}
+
+}  // namespace mocap::recon

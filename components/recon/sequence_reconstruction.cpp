@@ -1,0 +1,116 @@
+#include "recon/sequence_reconstruction.hpp"
+
+#include "posedb/view_set.hpp"
+#include "recon/savitzky_golay.hpp"
+
+namespace mocap::recon {
+
+std::string_view selection_name(Selection s) {
+  switch (s) {
+    case Selection::nearest:
+      return "nearest";
+    case Selection::greedy:
+      return "greedy";
+    case Selection::path:
+      return "path";
+  }
+  return "?";
+}
+
+std::string_view smoothing_name(Smoothing s) {
+  switch (s) {
+    case Smoothing::none:
+      return "none";
+    case Smoothing::one_euro:
+      return "1euro";
+    case Smoothing::savitzky_golay:
+      return "savgol";
+  }
+  return "?";
+}
+
+Pose3D pose_in_camera(const posedb::Database& db, const Candidate& chosen) {
+  Pose3D pose;
+  pose.valid = true;
+  pose.chosen = chosen;
+  const posedb::View& view = db.views()[chosen.view];
+  const posedb::CameraPose camera = posedb::camera_pose(view, db.build_info().views.root_height_m);
+  pose.body_to_camera = camera.world_to_camera;
+  const auto j = db.joints(chosen.frame);
+  for (int b = 0; b < kBodyJoints; ++b) {
+    pose.joints[b] = camera.world_to_camera * glm::vec3(j[3 * b], j[3 * b + 1], j[3 * b + 2]);
+  }
+  return pose;
+}
+
+namespace {
+
+template <class Filter>
+void for_each_run(std::vector<Pose3D>& poses, Filter&& filter) {
+  std::size_t start = 0;
+  while (start < poses.size()) {
+    while (start < poses.size() && !poses[start].valid) ++start;
+    std::size_t end = start;
+    while (end < poses.size() && poses[end].valid) ++end;
+    if (end > start) filter(start, end);
+    start = end;
+  }
+}
+
+}  // namespace
+
+void smooth_sequence(std::vector<Pose3D>& poses, const SequenceOptions& options) {
+  if (options.smoothing == Smoothing::none) return;
+  if (options.smoothing == Smoothing::one_euro) {
+    for_each_run(poses, [&](std::size_t start, std::size_t end) {
+      std::array<OneEuroFilterVec3, kBodyJoints> filters;
+      filters.fill(OneEuroFilterVec3(options.one_euro));
+      for (std::size_t t = start; t < end; ++t) {
+        const double seconds = static_cast<double>(t) / options.fps;
+        for (int j = 0; j < kBodyJoints; ++j)
+          poses[t].joints[j] = filters[j].filter(seconds, poses[t].joints[j]);
+      }
+    });
+    return;
+  }
+  const SavitzkyGolay sg(options.sg_order, options.sg_window);
+  for_each_run(poses, [&](std::size_t start, std::size_t end) {
+    std::vector<glm::vec3> track(end - start);
+    for (int j = 0; j < kBodyJoints; ++j) {
+      for (std::size_t t = start; t < end; ++t) track[t - start] = poses[t].joints[j];
+      const auto smoothed = sg.smooth(track);
+      for (std::size_t t = start; t < end; ++t) poses[t].joints[j] = smoothed[t - start];
+    }
+  });
+}
+
+std::vector<Pose3D> reconstruct_sequence(Matcher& matcher, const FrameBones& bones,
+                                         std::span<const BodyXyc> frames,
+                                         const SequenceOptions& options) {
+  std::vector<std::vector<Candidate>> candidates(frames.size());
+  for (std::size_t t = 0; t < frames.size(); ++t) matcher.match(frames[t], candidates[t]);
+
+  std::vector<Pose3D> poses(frames.size());
+  const posedb::Database& db = matcher.database();
+  if (options.selection == Selection::path) {
+    const auto path = best_path(candidates, bones, options.path);
+    for (std::size_t t = 0; t < frames.size(); ++t) {
+      if (!candidates[t].empty()) poses[t] = pose_in_camera(db, candidates[t][path[t]]);
+    }
+  } else {
+    TemporalSelector selector(bones, options.greedy);
+    for (std::size_t t = 0; t < frames.size(); ++t) {
+      if (candidates[t].empty()) {
+        selector.reset();  // a gap: the next frames start a new history
+        continue;
+      }
+      const std::size_t pick =
+          options.selection == Selection::nearest ? 0 : selector.select(candidates[t]);
+      poses[t] = pose_in_camera(db, candidates[t][pick]);
+    }
+  }
+  smooth_sequence(poses, options);
+  return poses;
+}
+
+}  // namespace mocap::recon

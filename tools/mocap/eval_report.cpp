@@ -1,0 +1,38 @@
+#include "eval_report.hpp"
+
+#include <unistd.h>
+
+#include <array>
+#include <cstdio>
+#include <fstream>
+#include <memory>
+#include <thread>
+
+namespace mocap::cli {
+
+nlohmann::json machine_description() {
+  std::string cpu = "unknown";
+  std::ifstream info("/proc/cpuinfo");
+  for (std::string line; std::getline(info, line);) {
+    if (line.rfind("model name", 0) == 0) {
+      cpu = line.substr(line.find(':') + 2);
+      break;
+    }
+  }
+  char host[256] = "";
+  gethostname(host, sizeof host - 1);
+  return {{"nproc", std::thread::hardware_concurrency()}, {"cpu", cpu}, {"host", host}};
+}
+
+std::string git_commit() {
+  std::unique_ptr<FILE, int (*)(FILE*)> pipe(popen("git rev-parse --short HEAD 2>/dev/null", "r"),
+                                             pclose);
+  if (!pipe) return "unknown";
+  std::array<char, 64> buf{};
+  if (!fgets(buf.data(), buf.size(), pipe.get())) return "unknown";
+  std::string s(buf.data());
+  while (!s.empty() && (s.back() == '\n' || s.back() == '\r')) s.pop_back();
+  return s.empty() ? "unknown" : s;
+}
+
+}  // namespace mocap::cli
