@@ -27,10 +27,18 @@ using FamilyTable = std::array<NamedSource, kBodyJoints>;
 const FamilyTable kCmu31 = {{
     {"Head", nullptr, {}, true},  // top of the head: the Head End Site
     {"Neck1"},                    // base of the neck just above the shoulder line
-    {"RightArm"}, {"RightForeArm"}, {"RightHand"},
-    {"LeftArm"}, {"LeftForeArm"}, {"LeftHand"},
-    {"RightUpLeg"}, {"RightLeg"}, {"RightFoot"},
-    {"LeftUpLeg"}, {"LeftLeg"}, {"LeftFoot"},
+    {"RightArm"},
+    {"RightForeArm"},
+    {"RightHand"},
+    {"LeftArm"},
+    {"LeftForeArm"},
+    {"LeftHand"},
+    {"RightUpLeg"},
+    {"RightLeg"},
+    {"RightFoot"},
+    {"LeftUpLeg"},
+    {"LeftLeg"},
+    {"LeftFoot"},
     {"LeftUpLeg", "RightUpLeg"},
 }};
 
@@ -38,30 +46,54 @@ const FamilyTable kCmu31 = {{
 const FamilyTable kCmuAsf = {{
     {"head", nullptr, {}, true},  // top of the head: the end of the head bone
     {"upperneck"},
-    {"rhumerus"}, {"rradius"}, {"rwrist"},
-    {"lhumerus"}, {"lradius"}, {"lwrist"},
-    {"rfemur"}, {"rtibia"}, {"rfoot"},
-    {"lfemur"}, {"ltibia"}, {"lfoot"},
+    {"rhumerus"},
+    {"rradius"},
+    {"rwrist"},
+    {"lhumerus"},
+    {"lradius"},
+    {"lwrist"},
+    {"rfemur"},
+    {"rtibia"},
+    {"rfoot"},
+    {"lfemur"},
+    {"ltibia"},
+    {"lfoot"},
     {"lfemur", "rfemur"},
 }};
 
 const FamilyTable kCmuDaz = {{
     {"leftEye", "rightEye"},  // eye level: the figure has no head-top point
     {"neck"},
-    {"rShldr"}, {"rForeArm"}, {"rHand"},
-    {"lShldr"}, {"lForeArm"}, {"lHand"},
-    {"rThigh"}, {"rShin"}, {"rFoot"},
-    {"lThigh"}, {"lShin"}, {"lFoot"},
+    {"rShldr"},
+    {"rForeArm"},
+    {"rHand"},
+    {"lShldr"},
+    {"lForeArm"},
+    {"lHand"},
+    {"rThigh"},
+    {"rShin"},
+    {"rFoot"},
+    {"lThigh"},
+    {"lShin"},
+    {"lFoot"},
     {"lThigh", "rThigh"},
 }};
 
 const FamilyTable kBandai = {{
     {"Head", nullptr, {10.0f, 0.0f, 0.0f}},  // head top: 10 cm along Head's bone axis (+X)
     {"Neck"},
-    {"UpperArm_R"}, {"LowerArm_R"}, {"Hand_R"},
-    {"UpperArm_L"}, {"LowerArm_L"}, {"Hand_L"},
-    {"UpperLeg_R"}, {"LowerLeg_R"}, {"Foot_R"},
-    {"UpperLeg_L"}, {"LowerLeg_L"}, {"Foot_L"},
+    {"UpperArm_R"},
+    {"LowerArm_R"},
+    {"Hand_R"},
+    {"UpperArm_L"},
+    {"LowerArm_L"},
+    {"Hand_L"},
+    {"UpperLeg_R"},
+    {"LowerLeg_R"},
+    {"Foot_R"},
+    {"UpperLeg_L"},
+    {"LowerLeg_L"},
+    {"Foot_L"},
     {"UpperLeg_L", "UpperLeg_R"},
 }};
 
@@ -86,10 +118,12 @@ const std::array<std::vector<const char*>, kBodyJoints> kGenericNames = {{
 }};
 
 std::string fold(std::string_view name) {
-  if (const auto colon = name.rfind(':'); colon != std::string_view::npos) name.remove_prefix(colon + 1);
+  if (const auto colon = name.rfind(':'); colon != std::string_view::npos)
+    name.remove_prefix(colon + 1);
   std::string out;
   for (char c : name) {
-    if (std::isalnum(static_cast<unsigned char>(c))) out.push_back(static_cast<char>(std::tolower(static_cast<unsigned char>(c))));
+    if (std::isalnum(static_cast<unsigned char>(c)))
+      out.push_back(static_cast<char>(std::tolower(static_cast<unsigned char>(c))));
   }
   return out;
 }
@@ -105,7 +139,8 @@ int end_site_of(const Skeleton& s, int joint) {
   return -1;
 }
 
-BodyMapping from_table(const Skeleton& s, const FamilyTable& table, Family family, const std::string& source) {
+BodyMapping from_table(const Skeleton& s, const FamilyTable& table, Family family,
+                       const std::string& source) {
   BodyMapping m;
   m.family = family;
   for (int b = 0; b < kBodyJoints; ++b) {
@@ -116,9 +151,10 @@ BodyMapping from_table(const Skeleton& s, const FamilyTable& table, Family famil
     if (n.other) out.other = s.find(n.other);
     out.local_offset = n.local_offset;
     if (out.joint < 0 || (n.other && out.other < 0)) {
-      throw InputError(source, std::string("skeleton looks like the ") + std::string(family_name(family)) +
-                                   " family but has no joint '" + n.joint + "' for body joint '" +
-                                   std::string(kJointNames[b]) + "'");
+      throw InputError(source, std::string("skeleton looks like the ") +
+                                   std::string(family_name(family)) + " family but has no joint '" +
+                                   n.joint + "' for body joint '" + std::string(kJointNames[b]) +
+                                   "'");
     }
   }
   return m;
@@ -137,10 +173,12 @@ int find_generic(const Skeleton& s, const std::vector<const char*>& names) {
 float guess_metres_per_unit(const Skeleton& s, const BodyMapping& m) {
   auto chain_length = [&](int from, int to) {
     float length = 0.0f;
-    for (int j = to; j >= 0 && j != from; j = s.joints[j].parent) length += glm::length(s.joints[j].offset);
+    for (int j = to; j >= 0 && j != from; j = s.joints[j].parent)
+      length += glm::length(s.joints[j].offset);
     return length;
   };
-  const float leg = chain_length(m.joints[index(Joint::left_hip)].joint, m.joints[index(Joint::left_ankle)].joint);
+  const float leg = chain_length(m.joints[index(Joint::left_hip)].joint,
+                                 m.joints[index(Joint::left_ankle)].joint);
   const float candidates[] = {1.0f, 0.01f, 0.001f, 0.0254f, kCmuMetresPerUnit};
   float best = 1.0f, best_error = 1e30f;
   for (float c : candidates) {
@@ -156,17 +194,20 @@ BodyMapping generic_mapping(const Skeleton& s, const std::string& source) {
   std::string missing;
   for (int b = 0; b < kBodyJoints - 1; ++b) {
     m.joints[b].joint = find_generic(s, kGenericNames[b]);
-    if (m.joints[b].joint < 0) missing += (missing.empty() ? "" : ", ") + std::string(kJointNames[b]);
+    if (m.joints[b].joint < 0)
+      missing += (missing.empty() ? "" : ", ") + std::string(kJointNames[b]);
   }
   if (!missing.empty()) {
-    throw InputError(source, "cannot map this skeleton to the 15-joint body: no joint found for " + missing +
-                                 " (known families: cmu31 cgspeed, cmu_daz, bandai; other skeletons need "
-                                 "common joint names such as LeftArm, LeftForeArm, LeftHand, LeftUpLeg)");
+    throw InputError(
+        source, "cannot map this skeleton to the 15-joint body: no joint found for " + missing +
+                    " (known families: cmu31 cgspeed, cmu_daz, bandai; other skeletons need "
+                    "common joint names such as LeftArm, LeftForeArm, LeftHand, LeftUpLeg)");
   }
   // A head joint is at the base of the skull: use its End Site (the top) when it has one.
   const int head = m.joints[index(Joint::head)].joint;
   if (const int top = end_site_of(s, head); top >= 0) m.joints[index(Joint::head)].joint = top;
-  m.joints[index(Joint::root)] = {m.joints[index(Joint::left_hip)].joint, m.joints[index(Joint::right_hip)].joint, {}};
+  m.joints[index(Joint::root)] = {
+      m.joints[index(Joint::left_hip)].joint, m.joints[index(Joint::right_hip)].joint, {}};
   m.metres_per_unit = guess_metres_per_unit(s, m);
   m.notes = "generic skeleton mapped by joint names; units guessed from the leg length (" +
             std::to_string(m.metres_per_unit) + " m per unit)";
@@ -177,46 +218,61 @@ BodyMapping generic_mapping(const Skeleton& s, const std::string& source) {
 
 std::string_view family_name(Family f) {
   switch (f) {
-    case Family::cmu31: return "cmu31";
-    case Family::cmu_asf: return "cmu_asf";
-    case Family::cmu_daz: return "cmu_daz";
-    case Family::bandai: return "bandai";
-    case Family::generic: return "generic";
+    case Family::cmu31:
+      return "cmu31";
+    case Family::cmu_asf:
+      return "cmu_asf";
+    case Family::cmu_daz:
+      return "cmu_daz";
+    case Family::bandai:
+      return "bandai";
+    case Family::generic:
+      return "generic";
   }
   return "?";
 }
 
 BodyMapping map_to_body(const Skeleton& s, const std::string& source) {
-  if (has_all(s, {"Hips", "LHipJoint", "RHipJoint", "LowerBack", "Spine1", "Neck1", "LeftForeArm"})) {
+  if (has_all(s,
+              {"Hips", "LHipJoint", "RHipJoint", "LowerBack", "Spine1", "Neck1", "LeftForeArm"})) {
     BodyMapping m = from_table(s, kCmu31, Family::cmu31, source);
     m.metres_per_unit = kCmuMetresPerUnit;
     m.first_frame_is_reference = true;
-    m.notes = "cgspeed CMU: head = Head End Site (top of head), neck = Neck1, root = midpoint of the UpLeg joints";
+    m.notes =
+        "cgspeed CMU: head = Head End Site (top of head), neck = Neck1, root = midpoint of the "
+        "UpLeg joints";
     return m;
   }
   if (has_all(s, {"lhipjoint", "lfemur", "ltibia", "lhumerus", "lradius", "upperneck", "head"})) {
     BodyMapping m = from_table(s, kCmuAsf, Family::cmu_asf, source);
     m.metres_per_unit = kCmuMetresPerUnit;
-    m.notes = "CMU ASF/AMC: head = end of the head bone, neck = upperneck, root = midpoint of the femur starts";
+    m.notes =
+        "CMU ASF/AMC: head = end of the head bone, neck = upperneck, root = midpoint of the femur "
+        "starts";
     return m;
   }
   if (has_all(s, {"hip", "abdomen", "chest", "rShldr", "lShldr", "rThigh", "lThigh", "leftEye"})) {
     BodyMapping m = from_table(s, kCmuDaz, Family::cmu_daz, source);
     m.metres_per_unit = 0.01f;
     m.first_frame_is_reference = true;
-    m.notes = "cgspeed Daz: head = midpoint of the eyes (no head-top point), root = midpoint of the thighs";
+    m.notes =
+        "cgspeed Daz: head = midpoint of the eyes (no head-top point), root = midpoint of the "
+        "thighs";
     return m;
   }
   if (has_all(s, {"joint_Root", "Hips", "UpperArm_L", "LowerArm_R", "UpperLeg_L", "Toes_R"})) {
     BodyMapping m = from_table(s, kBandai, Family::bandai, source);
     m.metres_per_unit = 0.01f;
-    m.notes = "Bandai: head = Head + 10 cm along its bone axis (head top), root = midpoint of the UpperLeg joints";
+    m.notes =
+        "Bandai: head = Head + 10 cm along its bone axis (head top), root = midpoint of the "
+        "UpperLeg joints";
     return m;
   }
   return generic_mapping(s, source);
 }
 
-void body_positions(const BodyMapping& m, const GlobalPose& pose, std::array<glm::vec3, kBodyJoints>& out) {
+void body_positions(const BodyMapping& m, const GlobalPose& pose,
+                    std::array<glm::vec3, kBodyJoints>& out) {
   for (int b = 0; b < kBodyJoints; ++b) {
     const BodyJointSource& src = m.joints[b];
     glm::vec3 p = pose.position[src.joint];

@@ -23,7 +23,7 @@ std::string_view family_name(Family f);
 // displaced by an offset in the first joint's local frame (file units).
 struct BodyJointSource {
   int joint = -1;
-  int other = -1;              // >= 0: midpoint of `joint` and `other`
+  int other = -1;  // >= 0: midpoint of `joint` and `other`
   glm::vec3 local_offset{0.0f};
 };
 
@@ -33,7 +33,7 @@ struct BodyMapping {
   float metres_per_unit = 1.0f;
   // Frame 0 of the file is an inserted reference pose, not capture data (the cgspeed files).
   bool first_frame_is_reference = false;
-  std::string notes;           // how derived joints were made, for `db info` and reports
+  std::string notes;  // how derived joints were made, for `db info` and reports
 };
 
 // Recognises the family and builds the mapping. Throws InputError(source, ...) naming the body

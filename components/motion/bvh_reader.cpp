@@ -44,7 +44,8 @@ class Tokenizer {
       fail(std::string("number out of range for ") + what + ": '" + std::string(original) + "'");
     }
     if (ec != std::errc() || end != tok.data() + tok.size() || !std::isfinite(value)) {
-      fail(std::string("expected a number for ") + what + ", found '" + std::string(original) + "'");
+      fail(std::string("expected a number for ") + what + ", found '" + std::string(original) +
+           "'");
     }
     return value;
   }
@@ -54,7 +55,8 @@ class Tokenizer {
     long value = 0;
     const auto [end, ec] = std::from_chars(tok.data(), tok.data() + tok.size(), value);
     if (ec != std::errc() || end != tok.data() + tok.size()) {
-      fail(std::string("expected a whole number for ") + what + ", found '" + std::string(tok) + "'");
+      fail(std::string("expected a whole number for ") + what + ", found '" + std::string(tok) +
+           "'");
     }
     return value;
   }
@@ -86,7 +88,8 @@ Channel parse_channel(Tokenizer& tok) {
     // Some exporters write lower-case channel names; accept them.
     if (text.size() == name.size() &&
         std::equal(text.begin(), text.end(), name.begin(), [](char a, char b) {
-          return std::tolower(static_cast<unsigned char>(a)) == std::tolower(static_cast<unsigned char>(b));
+          return std::tolower(static_cast<unsigned char>(a)) ==
+                 std::tolower(static_cast<unsigned char>(b));
         })) {
       return channel;
     }
@@ -99,7 +102,8 @@ constexpr int kMaxDepth = 1000;
 
 void parse_joint(Tokenizer& tok, Skeleton& skel, int parent, bool end_site, int depth) {
   if (depth > kMaxDepth) tok.fail("hierarchy nested deeper than " + std::to_string(kMaxDepth));
-  if (skel.joint_count() >= kMaxJoints) tok.fail("more than " + std::to_string(kMaxJoints) + " joints");
+  if (skel.joint_count() >= kMaxJoints)
+    tok.fail("more than " + std::to_string(kMaxJoints) + " joints");
   SkeletonJoint joint;
   joint.parent = parent;
   joint.end_site = end_site;
@@ -145,7 +149,8 @@ void parse_frame_header(Tokenizer& tok, Clip& clip) {
     tok.fail("expected 'Frames:', found '" + std::string(word) + "'");
   }
   const long frames = tok.integer("the frame count");
-  if (frames < 0 || frames > 100'000'000) tok.fail("implausible frame count " + std::to_string(frames));
+  if (frames < 0 || frames > 100'000'000)
+    tok.fail("implausible frame count " + std::to_string(frames));
   clip.frame_count = static_cast<int>(frames);
   tok.expect("Frame");
   word = tok.next("'Time:'");
@@ -177,7 +182,8 @@ Clip parse_bvh(std::string_view text, const std::string& source) {
   clip.skeleton.assign_channel_slots();
   parse_frame_header(tok, clip);
   const int channels = clip.skeleton.channel_count;
-  if (channels == 0 && clip.frame_count > 0) tok.fail("frames given but the hierarchy has no channels");
+  if (channels == 0 && clip.frame_count > 0)
+    tok.fail("frames given but the hierarchy has no channels");
   // Each value takes at least two bytes of text: refuse counts the file cannot hold before
   // allocating for them.
   const size_t total = static_cast<size_t>(clip.frame_count) * static_cast<size_t>(channels);
@@ -191,8 +197,8 @@ Clip parse_bvh(std::string_view text, const std::string& source) {
     for (int c = 0; c < channels; ++c) {
       if (tok.at_end()) {
         tok.fail("file is truncated: frame " + std::to_string(f) + " has " + std::to_string(c) +
-                 " of " + std::to_string(channels) + " values (" + std::to_string(clip.frame_count) +
-                 " frames declared)");
+                 " of " + std::to_string(channels) + " values (" +
+                 std::to_string(clip.frame_count) + " frames declared)");
       }
       row[c] = tok.number("a channel value");
     }

@@ -11,10 +11,14 @@ namespace {
 glm::quat axis_rotation(Channel c, float degrees) {
   const float r = glm::radians(degrees);
   switch (c) {
-    case Channel::Xrotation: return glm::angleAxis(r, glm::vec3(1, 0, 0));
-    case Channel::Yrotation: return glm::angleAxis(r, glm::vec3(0, 1, 0));
-    case Channel::Zrotation: return glm::angleAxis(r, glm::vec3(0, 0, 1));
-    default: return glm::quat(1, 0, 0, 0);
+    case Channel::Xrotation:
+      return glm::angleAxis(r, glm::vec3(1, 0, 0));
+    case Channel::Yrotation:
+      return glm::angleAxis(r, glm::vec3(0, 1, 0));
+    case Channel::Zrotation:
+      return glm::angleAxis(r, glm::vec3(0, 0, 1));
+    default:
+      return glm::quat(1, 0, 0, 0);
   }
 }
 
@@ -26,13 +30,20 @@ glm::vec3 euler_for_order(const glm::quat& q, const Channel order[3]) {
     return order[0] == x && order[1] == y && order[2] == z;
   };
   using enum Channel;
-  if (is(Xrotation, Yrotation, Zrotation)) glm::extractEulerAngleXYZ(m, a, b, c);
-  else if (is(Xrotation, Zrotation, Yrotation)) glm::extractEulerAngleXZY(m, a, b, c);
-  else if (is(Yrotation, Xrotation, Zrotation)) glm::extractEulerAngleYXZ(m, a, b, c);
-  else if (is(Yrotation, Zrotation, Xrotation)) glm::extractEulerAngleYZX(m, a, b, c);
-  else if (is(Zrotation, Xrotation, Yrotation)) glm::extractEulerAngleZXY(m, a, b, c);
-  else if (is(Zrotation, Yrotation, Xrotation)) glm::extractEulerAngleZYX(m, a, b, c);
-  else throw std::invalid_argument("to_clip: rotation channels must name three different axes");
+  if (is(Xrotation, Yrotation, Zrotation))
+    glm::extractEulerAngleXYZ(m, a, b, c);
+  else if (is(Xrotation, Zrotation, Yrotation))
+    glm::extractEulerAngleXZY(m, a, b, c);
+  else if (is(Yrotation, Xrotation, Zrotation))
+    glm::extractEulerAngleYXZ(m, a, b, c);
+  else if (is(Yrotation, Zrotation, Xrotation))
+    glm::extractEulerAngleYZX(m, a, b, c);
+  else if (is(Zrotation, Xrotation, Yrotation))
+    glm::extractEulerAngleZXY(m, a, b, c);
+  else if (is(Zrotation, Yrotation, Xrotation))
+    glm::extractEulerAngleZYX(m, a, b, c);
+  else
+    throw std::invalid_argument("to_clip: rotation channels must name three different axes");
   return {a, b, c};
 }
 
@@ -62,10 +73,18 @@ PoseSequence to_poses(const Clip& clip) {
       for (size_t c = 0; c < joint.channels.size(); ++c) {
         const float v = row[joint.first_channel + c];
         switch (joint.channels[c]) {
-          case Channel::Xposition: t.x = v; break;
-          case Channel::Yposition: t.y = v; break;
-          case Channel::Zposition: t.z = v; break;
-          default: r = r * axis_rotation(joint.channels[c], v); break;
+          case Channel::Xposition:
+            t.x = v;
+            break;
+          case Channel::Yposition:
+            t.y = v;
+            break;
+          case Channel::Zposition:
+            t.z = v;
+            break;
+          default:
+            r = r * axis_rotation(joint.channels[c], v);
+            break;
         }
       }
       out.translation[out.at(f, j)] = t;
@@ -90,24 +109,36 @@ Clip to_clip(const PoseSequence& poses) {
       int rotations = 0;
       for (Channel c : joint.channels) {
         if (is_rotation(c)) {
-          if (rotations == 3) throw std::invalid_argument("to_clip: joint " + joint.name + " has more than three rotation channels");
+          if (rotations == 3)
+            throw std::invalid_argument("to_clip: joint " + joint.name +
+                                        " has more than three rotation channels");
           order[rotations++] = c;
         }
       }
       if (rotations != 0 && rotations != 3) {
-        throw std::invalid_argument("to_clip: joint " + joint.name + " needs 0 or 3 rotation channels");
+        throw std::invalid_argument("to_clip: joint " + joint.name +
+                                    " needs 0 or 3 rotation channels");
       }
       const glm::vec3 t = poses.translation[poses.at(f, j)];
       glm::vec3 angles(0.0f);
-      if (rotations == 3) angles = glm::degrees(euler_for_order(poses.rotation[poses.at(f, j)], order));
+      if (rotations == 3)
+        angles = glm::degrees(euler_for_order(poses.rotation[poses.at(f, j)], order));
       int next_angle = 0;
       for (size_t c = 0; c < joint.channels.size(); ++c) {
         float& v = row[joint.first_channel + c];
         switch (joint.channels[c]) {
-          case Channel::Xposition: v = t.x; break;
-          case Channel::Yposition: v = t.y; break;
-          case Channel::Zposition: v = t.z; break;
-          default: v = angles[next_angle++]; break;
+          case Channel::Xposition:
+            v = t.x;
+            break;
+          case Channel::Yposition:
+            v = t.y;
+            break;
+          case Channel::Zposition:
+            v = t.z;
+            break;
+          default:
+            v = angles[next_angle++];
+            break;
         }
       }
     }
@@ -130,7 +161,8 @@ PoseSequence slice(const PoseSequence& poses, int first, int count) {
 }
 
 PoseSequence resample(const PoseSequence& poses, double fps) {
-  if (!(fps > 0.0) || !(poses.fps > 0.0)) throw std::invalid_argument("resample: frame rates must be positive");
+  if (!(fps > 0.0) || !(poses.fps > 0.0))
+    throw std::invalid_argument("resample: frame rates must be positive");
   PoseSequence out;
   out.skeleton = poses.skeleton;
   out.fps = fps;
@@ -151,7 +183,8 @@ PoseSequence resample(const PoseSequence& poses, double fps) {
       const glm::quat qa = poses.rotation[poses.at(a, j)];
       glm::quat qb = poses.rotation[poses.at(b, j)];
       if (glm::dot(qa, qb) < 0.0f) qb = -qb;
-      out.translation[out.at(k, j)] = glm::mix(poses.translation[poses.at(a, j)], poses.translation[poses.at(b, j)], w);
+      out.translation[out.at(k, j)] =
+          glm::mix(poses.translation[poses.at(a, j)], poses.translation[poses.at(b, j)], w);
       out.rotation[out.at(k, j)] = w < 1e-6f ? qa : glm::normalize(glm::slerp(qa, qb, w));
     }
   }

@@ -23,7 +23,8 @@ struct PoseSequence {
 
   int joint_count() const { return skeleton.joint_count(); }
   size_t at(int frame, int joint) const {
-    return static_cast<size_t>(frame) * static_cast<size_t>(joint_count()) + static_cast<size_t>(joint);
+    return static_cast<size_t>(frame) * static_cast<size_t>(joint_count()) +
+           static_cast<size_t>(joint);
   }
 };
 

@@ -8,12 +8,18 @@ bool is_rotation(Channel c) {
 
 const char* channel_name(Channel c) {
   switch (c) {
-    case Channel::Xposition: return "Xposition";
-    case Channel::Yposition: return "Yposition";
-    case Channel::Zposition: return "Zposition";
-    case Channel::Xrotation: return "Xrotation";
-    case Channel::Yrotation: return "Yrotation";
-    case Channel::Zrotation: return "Zrotation";
+    case Channel::Xposition:
+      return "Xposition";
+    case Channel::Yposition:
+      return "Yposition";
+    case Channel::Zposition:
+      return "Zposition";
+    case Channel::Xrotation:
+      return "Xrotation";
+    case Channel::Yrotation:
+      return "Yrotation";
+    case Channel::Zrotation:
+      return "Zrotation";
   }
   return "?";
 }

@@ -9,18 +9,25 @@
 
 namespace mocap::motion {
 
-enum class Channel : std::uint8_t { Xposition, Yposition, Zposition, Xrotation, Yrotation, Zrotation };
+enum class Channel : std::uint8_t {
+  Xposition,
+  Yposition,
+  Zposition,
+  Xrotation,
+  Yrotation,
+  Zrotation
+};
 
 bool is_rotation(Channel c);
 const char* channel_name(Channel c);
 
 struct SkeletonJoint {
   std::string name;
-  int parent = -1;             // index into Skeleton::joints, -1 for a root
-  glm::vec3 offset{0.0f};      // from the parent, in the parent's frame, file units
+  int parent = -1;         // index into Skeleton::joints, -1 for a root
+  glm::vec3 offset{0.0f};  // from the parent, in the parent's frame, file units
   std::vector<Channel> channels;
-  bool end_site = false;       // BVH "End Site": no channels, a point only
-  int first_channel = 0;       // index of this joint's first value in a frame
+  bool end_site = false;  // BVH "End Site": no channels, a point only
+  int first_channel = 0;  // index of this joint's first value in a frame
 };
 
 // Joints are stored parents-first (a joint's parent always has a smaller index).
@@ -36,13 +43,15 @@ struct Skeleton {
 
 // Motion as the file stores it: one row of channel values per frame (degrees, file units).
 struct Clip {
-  std::string source;          // file path, for messages
+  std::string source;  // file path, for messages
   Skeleton skeleton;
   double frame_time = 1.0 / 120.0;
   int frame_count = 0;
-  std::vector<float> values;   // frame_count * skeleton.channel_count, row-major
+  std::vector<float> values;  // frame_count * skeleton.channel_count, row-major
 
-  const float* frame(int f) const { return values.data() + static_cast<size_t>(f) * skeleton.channel_count; }
+  const float* frame(int f) const {
+    return values.data() + static_cast<size_t>(f) * skeleton.channel_count;
+  }
   float* frame(int f) { return values.data() + static_cast<size_t>(f) * skeleton.channel_count; }
   double fps() const { return 1.0 / frame_time; }
 };

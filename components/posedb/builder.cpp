@@ -25,7 +25,8 @@ namespace {
 
 std::string lower_extension(const fs::path& p) {
   std::string e = p.extension().string();
-  std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  std::transform(e.begin(), e.end(), e.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   return e;
 }
 
@@ -35,12 +36,15 @@ std::string asf_for(const fs::path& amc) {
   const fs::path subject = amc.parent_path() / (stem.substr(0, stem.find('_')) + ".asf");
   if (fs::exists(subject)) return subject.string();
   std::vector<fs::path> found;
-  for (const auto& e : fs::directory_iterator(amc.parent_path().empty() ? fs::path(".") : amc.parent_path())) {
+  for (const auto& e :
+       fs::directory_iterator(amc.parent_path().empty() ? fs::path(".") : amc.parent_path())) {
     if (e.is_regular_file() && lower_extension(e.path()) == ".asf") found.push_back(e.path());
   }
   if (found.size() == 1) return found.front().string();
-  throw InputError(amc.string(), found.empty() ? "no .asf skeleton beside this .amc file"
-                                              : "several .asf files beside this .amc file; expected " + subject.string());
+  throw InputError(amc.string(),
+                   found.empty()
+                       ? "no .asf skeleton beside this .amc file"
+                       : "several .asf files beside this .amc file; expected " + subject.string());
 }
 
 void add_file(const fs::path& p, std::set<std::string>& out) {
@@ -52,9 +56,9 @@ void add_file(const fs::path& p, std::set<std::string>& out) {
 // One clip after reading: the part of the database it contributes, before projection.
 struct ClipFrames {
   ClipInfo info;
-  std::vector<FrameRecord> frames;             // clip index filled in later
+  std::vector<FrameRecord> frames;                         // clip index filled in later
   std::vector<std::array<glm::vec3, kBodyJoints>> joints;  // root-relative, facing +Z, metres
-  std::vector<float> rotations;                // frame * joints * 4
+  std::vector<float> rotations;                            // frame * joints * 4
 };
 
 motion::Clip read_clip(const std::string& file) {
@@ -76,7 +80,8 @@ bool facing(const std::array<glm::vec3, kBodyJoints>& b, float& heading) {
 }
 
 // Runs of frames that hold capture data: after the reference frame, without all-zero frames.
-std::vector<std::pair<int, int>> capture_runs(const motion::Clip& clip, bool skip_first, BuildReport& report, std::mutex& m) {
+std::vector<std::pair<int, int>> capture_runs(const motion::Clip& clip, bool skip_first,
+                                              BuildReport& report, std::mutex& m) {
   std::vector<std::pair<int, int>> runs;
   int start = -1;
   std::size_t blank = 0;
@@ -95,7 +100,8 @@ std::vector<std::pair<int, int>> capture_runs(const motion::Clip& clip, bool ski
   return runs;
 }
 
-void add_run(const motion::PoseSequence& poses, const motion::BodyMapping& mapping, ClipFrames& out) {
+void add_run(const motion::PoseSequence& poses, const motion::BodyMapping& mapping,
+             ClipFrames& out) {
   motion::GlobalPose global;
   float last_heading = 0.0f;
   const int joints = poses.joint_count();
@@ -110,7 +116,8 @@ void add_run(const motion::PoseSequence& poses, const motion::BodyMapping& mappi
     const glm::quat turn = glm::angleAxis(-heading, glm::vec3(0, 1, 0));
     for (auto& p : body) p = turn * (p - root);
     out.joints.push_back(body);
-    out.frames.push_back({0, static_cast<std::uint32_t>(out.frames.size()), heading, {root.x, root.y, root.z}});
+    out.frames.push_back(
+        {0, static_cast<std::uint32_t>(out.frames.size()), heading, {root.x, root.y, root.z}});
     for (int j = 0; j < joints; ++j) {
       const glm::quat q = poses.rotation[poses.at(f, j)];
       out.rotations.insert(out.rotations.end(), {q.w, q.x, q.y, q.z});
@@ -118,7 +125,8 @@ void add_run(const motion::PoseSequence& poses, const motion::BodyMapping& mappi
   }
 }
 
-std::vector<ClipFrames> read_clips(const std::string& file, const BuildOptions& options, BuildReport& report, std::mutex& m) {
+std::vector<ClipFrames> read_clips(const std::string& file, const BuildOptions& options,
+                                   BuildReport& report, std::mutex& m) {
   const motion::Clip clip = read_clip(file);
   const motion::BodyMapping mapping = motion::map_to_body(clip.skeleton, clip.source);
   const bool is_amc = file.find('|') != std::string::npos;
@@ -129,7 +137,8 @@ std::vector<ClipFrames> read_clips(const std::string& file, const BuildOptions& 
     ClipFrames c;
     const fs::path path(is_amc ? file.substr(file.find('|') + 1) : file);
     c.info.name = path.filename().string();
-    if (!out.empty()) c.info.name.append("#").append(std::to_string(out.size() + 1));  // a later run of the file
+    if (!out.empty())
+      c.info.name.append("#").append(std::to_string(out.size() + 1));  // a later run of the file
     c.info.source = path.string();
     c.info.family = std::string(motion::family_name(mapping.family));
     c.info.mapping = mapping.notes;
@@ -195,8 +204,9 @@ void gather(std::vector<ClipFrames>& clips, DatabaseContents& db,
 }
 
 // Projects every frame through every view; rows in (frame, view) order.
-void project_all(const std::vector<std::array<glm::vec3, kBodyJoints>>& joints, const BuildOptions& options,
-                 DatabaseContents& db, const BuildProgress& progress, BuildReport& report) {
+void project_all(const std::vector<std::array<glm::vec3, kBodyJoints>>& joints,
+                 const BuildOptions& options, DatabaseContents& db, const BuildProgress& progress,
+                 BuildReport& report) {
   std::vector<CameraPose> cameras;
   for (const View& v : db.views) cameras.push_back(camera_pose(v, options.views.root_height_m));
   db.projections.reserve(joints.size() * cameras.size() * kPoseDims);
@@ -211,9 +221,11 @@ void project_all(const std::vector<std::array<glm::vec3, kBodyJoints>>& joints, 
         continue;
       }
       db.projections.insert(db.projections.end(), row.begin(), row.end());
-      db.projection_records.push_back({static_cast<std::uint32_t>(f), static_cast<std::uint32_t>(v)});
+      db.projection_records.push_back(
+          {static_cast<std::uint32_t>(f), static_cast<std::uint32_t>(v)});
     }
-    if (progress && f % 512 == 0) progress("project", static_cast<double>(f) / static_cast<double>(joints.size()));
+    if (progress && f % 512 == 0)
+      progress("project", static_cast<double>(f) / static_cast<double>(joints.size()));
   }
   if (progress) progress("project", 1.0);
 }
@@ -221,10 +233,12 @@ void project_all(const std::vector<std::array<glm::vec3, kBodyJoints>>& joints, 
 // Clusters the rows (the paper's clusters with representatives) and stores them grouped by cluster.
 void cluster(const BuildOptions& options, DatabaseContents& db, const BuildProgress& progress) {
   const std::size_t rows = db.projection_records.size();
-  const int k = options.clusters > 0 ? options.clusters
-                                     : std::max(16, static_cast<int>(std::sqrt(static_cast<double>(rows))));
+  const int k = options.clusters > 0
+                    ? options.clusters
+                    : std::max(16, static_cast<int>(std::sqrt(static_cast<double>(rows))));
   KMeansOptions km;
-  km.clusters = static_cast<int>(std::min<std::size_t>(static_cast<std::size_t>(k), std::max<std::size_t>(rows, 1)));
+  km.clusters = static_cast<int>(
+      std::min<std::size_t>(static_cast<std::size_t>(k), std::max<std::size_t>(rows, 1)));
   km.iterations = options.kmeans_iterations;
   km.sample_size = options.kmeans_sample;
   km.seed = options.seed;
@@ -264,12 +278,14 @@ std::vector<std::string> collect_motion_files(const std::vector<std::string>& pa
     const fs::path path(p);
     std::error_code ec;
     if (fs::is_directory(path, ec)) {
-      for (const auto& e : fs::recursive_directory_iterator(path, fs::directory_options::skip_permission_denied)) {
+      for (const auto& e :
+           fs::recursive_directory_iterator(path, fs::directory_options::skip_permission_denied)) {
         if (e.is_regular_file()) add_file(e.path(), files);
       }
     } else if (fs::is_regular_file(path, ec)) {
       const std::string ext = lower_extension(path);
-      if (ext != ".bvh" && ext != ".amc") throw InputError(p, "not a motion file (expected .bvh, or .amc with its .asf)");
+      if (ext != ".bvh" && ext != ".amc")
+        throw InputError(p, "not a motion file (expected .bvh, or .amc with its .asf)");
       add_file(path, files);
     } else {
       throw InputError(p, "no such file or folder");
@@ -280,7 +296,8 @@ std::vector<std::string> collect_motion_files(const std::vector<std::string>& pa
 
 DatabaseContents build_database(const std::vector<std::string>& files, const BuildOptions& options,
                                 const BuildProgress& progress, BuildReport& report) {
-  if (!(options.fps > 0.0 && options.fps <= 1000.0)) throw InputError("--fps", "must be between 0 and 1000");
+  if (!(options.fps > 0.0 && options.fps <= 1000.0))
+    throw InputError("--fps", "must be between 0 and 1000");
   const auto started = std::chrono::steady_clock::now();
   DatabaseContents db;
   db.views = make_views(options.views);
@@ -288,8 +305,10 @@ DatabaseContents build_database(const std::vector<std::string>& files, const Bui
   std::vector<std::array<glm::vec3, kBodyJoints>> joints;
   gather(clips, db, joints);
   if (db.frames.empty()) {
-    throw InputError("", "no usable motion in " + std::to_string(files.size()) + " file(s)" +
-                             (report.skipped.empty() ? std::string() : "; first problem: " + report.skipped.front()));
+    throw InputError("",
+                     "no usable motion in " + std::to_string(files.size()) + " file(s)" +
+                         (report.skipped.empty() ? std::string()
+                                                 : "; first problem: " + report.skipped.front()));
   }
   project_all(joints, options, db, progress, report);
   cluster(options, db, progress);
@@ -300,7 +319,8 @@ DatabaseContents build_database(const std::vector<std::string>& files, const Bui
   db.build.seed = options.seed;
   db.build.created = now_iso();
   db.build.command = options.command;
-  db.build.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  db.build.build_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return db;
 }
 

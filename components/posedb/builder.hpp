@@ -16,12 +16,12 @@ struct BuildOptions {
   double fps = 24.0;
   ViewSetOptions views;
   Scaling scaling = Scaling::bbox_height;
-  int clusters = 0;           // 0: about sqrt(projections), at least 16
+  int clusters = 0;  // 0: about sqrt(projections), at least 16
   int kmeans_iterations = 8;
   std::size_t kmeans_sample = 200'000;
   std::uint64_t seed = 1;
   int threads = 2;
-  std::string command;        // recorded in the file
+  std::string command;  // recorded in the file
 };
 
 // Called as work proceeds; `stage` names the step ("read", "project", "cluster", ...).
@@ -29,10 +29,10 @@ using BuildProgress = std::function<void(std::string_view stage, double fraction
 
 struct BuildReport {
   std::size_t files_read = 0;
-  std::vector<std::string> skipped;        // "path: reason" for every file that could not be used
+  std::vector<std::string> skipped;  // "path: reason" for every file that could not be used
   std::size_t reference_frames_dropped = 0;
   std::size_t blank_frames_dropped = 0;
-  std::size_t projections_dropped = 0;     // could not be normalised
+  std::size_t projections_dropped = 0;  // could not be normalised
 };
 
 // Expands folders (recursively) into the motion files they hold: *.bvh, and *.amc with the

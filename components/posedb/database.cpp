@@ -56,7 +56,9 @@ struct Section {
   std::uint64_t size = 0;
   std::uint64_t count = 0;
   template <typename T>
-  const T* as() const { return reinterpret_cast<const T*>(data); }
+  const T* as() const {
+    return reinterpret_cast<const T*>(data);
+  }
 };
 
 }  // namespace
@@ -78,20 +80,23 @@ struct Database::Impl {
   void check_consistency() const;
 };
 
-Section Database::Impl::section(const format::SectionEntry* table, std::uint32_t count, const char* name,
-                                std::uint32_t element_size, bool verify) const {
+Section Database::Impl::section(const format::SectionEntry* table, std::uint32_t count,
+                                const char* name, std::uint32_t element_size, bool verify) const {
   const auto wanted = format::tag(name);
   for (std::uint32_t i = 0; i < count; ++i) {
     const auto& e = table[i];
     if (e.tag != wanted) continue;
-    if (e.offset % format::kAlignment != 0 || e.offset > file.size() || e.size > file.size() - e.offset) {
+    if (e.offset % format::kAlignment != 0 || e.offset > file.size() ||
+        e.size > file.size() - e.offset) {
       fail(std::string("section '") + name + "' lies outside the file: truncated or corrupted");
     }
     if (e.element_size != element_size || e.size % element_size != 0) {
-      fail(std::string("section '") + name + "' has records of an unexpected size: corrupted or foreign file");
+      fail(std::string("section '") + name +
+           "' has records of an unexpected size: corrupted or foreign file");
     }
     if (verify && format::crc32_of(file.data() + e.offset, e.size) != e.crc) {
-      fail(std::string("checksum mismatch in section '") + name + "': the file is corrupted; rebuild it with 'mocap db build'");
+      fail(std::string("checksum mismatch in section '") + name +
+           "': the file is corrupted; rebuild it with 'mocap db build'");
     }
     return {file.data() + e.offset, e.size, e.size / element_size};
   }
@@ -99,7 +104,8 @@ Section Database::Impl::section(const format::SectionEntry* table, std::uint32_t
 }
 
 void Database::Impl::load(bool verify) {
-  if (file.size() < sizeof(format::FileHeader)) fail("too small to be a pose database (" + std::to_string(file.size()) + " bytes)");
+  if (file.size() < sizeof(format::FileHeader))
+    fail("too small to be a pose database (" + std::to_string(file.size()) + " bytes)");
   format::FileHeader h;
   std::memcpy(&h, file.data(), sizeof h);
   if (h.magic != format::kMagic) fail("not a mocap pose database (wrong magic bytes)");
@@ -110,13 +116,15 @@ void Database::Impl::load(bool verify) {
   }
   if (h.version < 1) fail("invalid database version 0");
   if (h.file_size != file.size()) {
-    fail("truncated or extended: the header says " + std::to_string(h.file_size) + " bytes, the file has " +
-         std::to_string(file.size()));
+    fail("truncated or extended: the header says " + std::to_string(h.file_size) +
+         " bytes, the file has " + std::to_string(file.size()));
   }
-  const std::uint64_t table_bytes = static_cast<std::uint64_t>(h.section_count) * sizeof(format::SectionEntry);
+  const std::uint64_t table_bytes =
+      static_cast<std::uint64_t>(h.section_count) * sizeof(format::SectionEntry);
   if (h.section_count > 64 || sizeof h + table_bytes > file.size()) fail("corrupted section table");
   const auto* table = reinterpret_cast<const format::SectionEntry*>(file.data() + sizeof h);
-  if (format::crc32_of(table, table_bytes) != h.table_crc) fail("checksum mismatch in the section table: the file is corrupted");
+  if (format::crc32_of(table, table_bytes) != h.table_crc)
+    fail("checksum mismatch in the section table: the file is corrupted");
 
   const Section options = section(table, h.section_count, format::kOptions, 1, verify);
   const Section clip_text = section(table, h.section_count, format::kClips, 1, verify);
@@ -126,17 +134,22 @@ void Database::Impl::load(bool verify) {
   } catch (const std::exception& e) {
     fail(std::string("corrupted header data: ") + e.what());
   }
-  const Section view_section = section(table, h.section_count, format::kViews, 4 * sizeof(float), verify);
+  const Section view_section =
+      section(table, h.section_count, format::kViews, 4 * sizeof(float), verify);
   for (std::uint64_t i = 0; i < view_section.count; ++i) {
     const float* v = view_section.as<float>() + 4 * i;
     views.push_back({v[0], v[1], v[2], v[3]});
   }
   frames = section(table, h.section_count, format::kFrames, sizeof(FrameRecord), verify);
-  joints = section(table, h.section_count, format::kJoints, kBodyJoints * 3 * sizeof(float), verify);
+  joints =
+      section(table, h.section_count, format::kJoints, kBodyJoints * 3 * sizeof(float), verify);
   rotations = section(table, h.section_count, format::kRotations, 4 * sizeof(float), verify);
-  projections = section(table, h.section_count, format::kProjections, kPoseDims * sizeof(float), verify);
-  records = section(table, h.section_count, format::kProjectionRecords, sizeof(ProjectionRecord), verify);
-  centroids = section(table, h.section_count, format::kCentroids, kPoseDims * sizeof(float), verify);
+  projections =
+      section(table, h.section_count, format::kProjections, kPoseDims * sizeof(float), verify);
+  records =
+      section(table, h.section_count, format::kProjectionRecords, sizeof(ProjectionRecord), verify);
+  centroids =
+      section(table, h.section_count, format::kCentroids, kPoseDims * sizeof(float), verify);
   clusters = section(table, h.section_count, format::kClusters, sizeof(std::uint32_t), verify);
   check_consistency();
 }
@@ -147,17 +160,20 @@ void Database::Impl::check_consistency() const {
   if (records.count != projections.count) fail("projection tables disagree: corrupted");
   if (clusters.count != centroids.count + 1) fail("cluster tables disagree: corrupted");
   const auto* begin = clusters.as<std::uint32_t>();
-  if (begin[0] != 0 || begin[clusters.count - 1] != projections.count) fail("cluster offsets do not cover the projections: corrupted");
+  if (begin[0] != 0 || begin[clusters.count - 1] != projections.count)
+    fail("cluster offsets do not cover the projections: corrupted");
   for (std::uint64_t c = 1; c < clusters.count; ++c) {
     if (begin[c] < begin[c - 1]) fail("cluster offsets are not ordered: corrupted");
   }
   for (std::uint64_t i = 0; i < records.count; ++i) {
     const auto& r = records.as<ProjectionRecord>()[i];
-    if (r.frame >= frames.count || r.view >= views.size()) fail("projection " + std::to_string(i) + " points outside the tables: corrupted");
+    if (r.frame >= frames.count || r.view >= views.size())
+      fail("projection " + std::to_string(i) + " points outside the tables: corrupted");
   }
   for (std::size_t c = 0; c < clips.size(); ++c) {
     const ClipInfo& clip = clips[c];
-    const std::uint64_t quats = static_cast<std::uint64_t>(clip.frame_count) * clip.skeleton.joint_count();
+    const std::uint64_t quats =
+        static_cast<std::uint64_t>(clip.frame_count) * clip.skeleton.joint_count();
     if (static_cast<std::uint64_t>(clip.first_frame) + clip.frame_count > frames.count ||
         clip.rotation_offset > rotations.count || quats > rotations.count - clip.rotation_offset) {
       fail("clip '" + clip.name + "' points outside the tables: corrupted");
@@ -165,7 +181,8 @@ void Database::Impl::check_consistency() const {
   }
   for (std::uint64_t f = 0; f < frames.count; ++f) {
     const auto& r = frames.as<FrameRecord>()[f];
-    if (r.clip >= clips.size() || r.clip_frame >= clips[r.clip].frame_count) fail("frame " + std::to_string(f) + " points outside its clip: corrupted");
+    if (r.clip >= clips.size() || r.clip_frame >= clips[r.clip].frame_count)
+      fail("frame " + std::to_string(f) + " points outside its clip: corrupted");
   }
 }
 
@@ -189,7 +206,9 @@ std::span<const FrameRecord> Database::frames() const {
   return {impl_->frames.as<FrameRecord>(), impl_->frames.count};
 }
 std::span<const float, kBodyJoints * 3> Database::joints(std::uint32_t frame) const {
-  return std::span<const float, kBodyJoints * 3>(impl_->joints.as<float>() + static_cast<std::size_t>(frame) * kBodyJoints * 3, kBodyJoints * 3);
+  return std::span<const float, kBodyJoints * 3>(
+      impl_->joints.as<float>() + static_cast<std::size_t>(frame) * kBodyJoints * 3,
+      kBodyJoints * 3);
 }
 std::span<const float> Database::rotations(std::uint32_t frame) const {
   const FrameRecord& r = frames()[frame];
@@ -203,12 +222,12 @@ MatrixView Database::projections() const {
 std::span<const ProjectionRecord> Database::projection_records() const {
   return {impl_->records.as<ProjectionRecord>(), impl_->records.count};
 }
-MatrixView Database::centroids() const { return {impl_->centroids.as<float>(), impl_->centroids.count, kPoseDims}; }
+MatrixView Database::centroids() const {
+  return {impl_->centroids.as<float>(), impl_->centroids.count, kPoseDims};
+}
 std::span<const std::uint32_t> Database::cluster_begin() const {
   return {impl_->clusters.as<std::uint32_t>(), impl_->clusters.count};
 }
-std::string Database::options_json() const {
-  return format::build_info_to_json(impl_->build);
-}
+std::string Database::options_json() const { return format::build_info_to_json(impl_->build); }
 
 }  // namespace mocap::posedb

@@ -1,7 +1,8 @@
 #pragma once
 // The pose database: every mocap frame's 3D body and source rotations, and its normalised 2D
 // projections from many virtual cameras, with a cluster index. Read-only and memory-mapped: the
-// matcher reads the projection rows straight from the page cache. File layout: docs/pose-database.md.
+// matcher reads the projection rows straight from the page cache. File layout:
+// docs/pose-database.md.
 
 #include <cstdint>
 #include <memory>
@@ -21,30 +22,30 @@ inline constexpr std::uint32_t kDatabaseVersion = 1;
 // One database frame (a mocap frame after resampling).
 struct FrameRecord {
   std::uint32_t clip;
-  std::uint32_t clip_frame;   // index within the clip at the database frame rate
-  float heading_rad;          // the body's facing (yaw about +Y) that was removed; 0 = facing +Z
-  float root_m[3];            // root (mid-hips) position in the mocap world, metres
+  std::uint32_t clip_frame;  // index within the clip at the database frame rate
+  float heading_rad;         // the body's facing (yaw about +Y) that was removed; 0 = facing +Z
+  float root_m[3];           // root (mid-hips) position in the mocap world, metres
 };
 static_assert(sizeof(FrameRecord) == 24);
 
 struct ProjectionRecord {
-  std::uint32_t frame;        // index into frames()
-  std::uint32_t view;         // index into views()
+  std::uint32_t frame;  // index into frames()
+  std::uint32_t view;   // index into views()
 };
 static_assert(sizeof(ProjectionRecord) == 8);
 
 struct ClipInfo {
-  std::string name;           // file name without folder
-  std::string source;         // path as given at build time
-  std::string family;         // cmu31, cmu_daz, bandai, generic, asf_amc
-  std::string mapping;        // how the body joints were taken from the skeleton
+  std::string name;     // file name without folder
+  std::string source;   // path as given at build time
+  std::string family;   // cmu31, cmu_daz, bandai, generic, asf_amc
+  std::string mapping;  // how the body joints were taken from the skeleton
   double source_fps = 0.0;
   std::uint32_t source_first_frame = 0;  // first source frame used (after reference/blank frames)
   std::uint32_t first_frame = 0;         // index of its first frame in frames()
   std::uint32_t frame_count = 0;
-  std::uint64_t rotation_offset = 0;     // index of its first quaternion in rotations()
+  std::uint64_t rotation_offset = 0;  // index of its first quaternion in rotations()
   float metres_per_unit = 1.0f;
-  motion::Skeleton skeleton;             // source hierarchy, for BVH output
+  motion::Skeleton skeleton;  // source hierarchy, for BVH output
 };
 
 struct BuildInfo {
@@ -53,8 +54,8 @@ struct BuildInfo {
   ViewSetOptions views;
   int clusters = 0;
   std::uint64_t seed = 0;
-  std::string created;        // ISO time
-  std::string command;        // command line that built it
+  std::string created;  // ISO time
+  std::string command;  // command line that built it
   double build_seconds = 0.0;
 };
 

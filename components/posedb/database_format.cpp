@@ -3,8 +3,8 @@
 #include <cstring>
 #include <stdexcept>
 
-#include <nlohmann/json.hpp>
 #include <zlib.h>
+#include <nlohmann/json.hpp>
 
 namespace mocap::posedb::format {
 namespace {
@@ -12,8 +12,9 @@ namespace {
 using nlohmann::json;
 
 motion::Channel channel_from_name(const std::string& name) {
-  for (auto c : {motion::Channel::Xposition, motion::Channel::Yposition, motion::Channel::Zposition,
-                 motion::Channel::Xrotation, motion::Channel::Yrotation, motion::Channel::Zrotation}) {
+  for (auto c :
+       {motion::Channel::Xposition, motion::Channel::Yposition, motion::Channel::Zposition,
+        motion::Channel::Xrotation, motion::Channel::Yrotation, motion::Channel::Zrotation}) {
     if (name == motion::channel_name(c)) return c;
   }
   throw std::runtime_error("unknown channel '" + name + "'");
@@ -44,8 +45,10 @@ motion::Skeleton skeleton_from_json(const json& joints) {
     }
     const auto& o = j.at("offset");
     joint.offset = {o.at(0).get<float>(), o.at(1).get<float>(), o.at(2).get<float>()};
-    for (const auto& c : j.at("channels")) joint.channels.push_back(channel_from_name(c.get<std::string>()));
-    if (joint.channels.size() > 6) throw std::runtime_error("joint '" + joint.name + "' has more than 6 channels");
+    for (const auto& c : j.at("channels"))
+      joint.channels.push_back(channel_from_name(c.get<std::string>()));
+    if (joint.channels.size() > 6)
+      throw std::runtime_error("joint '" + joint.name + "' has more than 6 channels");
     joint.end_site = j.at("end_site").get<bool>();
     s.joints.push_back(std::move(joint));
   }
@@ -85,7 +88,8 @@ BuildInfo build_info_from_json(const std::string& text) {
   const json j = json::parse(text);
   BuildInfo b;
   b.fps = j.at("fps").get<double>();
-  if (!parse_scaling(j.at("scaling").get<std::string>(), b.scaling)) throw std::runtime_error("unknown scaling");
+  if (!parse_scaling(j.at("scaling").get<std::string>(), b.scaling))
+    throw std::runtime_error("unknown scaling");
   const auto& v = j.at("views");
   b.views.yaw_steps = v.at("yaw_steps").get<int>();
   b.views.heights_m = v.at("heights_m").get<std::vector<float>>();

@@ -18,10 +18,10 @@ inline constexpr std::uint64_t kAlignment = 64;
 struct FileHeader {
   std::array<char, 8> magic;
   std::uint32_t version;
-  std::uint32_t byte_order;     // kByteOrderMark as written by the machine that built the file
+  std::uint32_t byte_order;  // kByteOrderMark as written by the machine that built the file
   std::uint64_t file_size;
   std::uint32_t section_count;
-  std::uint32_t table_crc;      // CRC-32 of the section table
+  std::uint32_t table_crc;  // CRC-32 of the section table
 };
 static_assert(sizeof(FileHeader) == 32);
 

@@ -17,11 +17,14 @@ struct PendingSection {
 };
 
 template <typename T>
-PendingSection section(const char* tag, const std::vector<T>& v, std::uint32_t element_size = sizeof(T)) {
+PendingSection section(const char* tag, const std::vector<T>& v,
+                       std::uint32_t element_size = sizeof(T)) {
   return {tag, v.data(), v.size() * sizeof(T), element_size};
 }
 
-std::uint64_t align_up(std::uint64_t n) { return (n + format::kAlignment - 1) / format::kAlignment * format::kAlignment; }
+std::uint64_t align_up(std::uint64_t n) {
+  return (n + format::kAlignment - 1) / format::kAlignment * format::kAlignment;
+}
 
 }  // namespace
 
@@ -29,7 +32,8 @@ void write_database(const DatabaseContents& c, const std::string& path) {
   const std::string options = format::build_info_to_json(c.build);
   const std::string clips = format::clips_to_json(c.clips);
   std::vector<float> views;
-  for (const View& v : c.views) views.insert(views.end(), {v.yaw_deg, v.height_m, v.distance_m, v.pitch_deg});
+  for (const View& v : c.views)
+    views.insert(views.end(), {v.yaw_deg, v.height_m, v.distance_m, v.pitch_deg});
   const PendingSection pending[] = {
       {format::kOptions, options.data(), options.size(), 1},
       {format::kClips, clips.data(), clips.size(), 1},
@@ -44,25 +48,34 @@ void write_database(const DatabaseContents& c, const std::string& path) {
   };
   constexpr std::uint32_t count = std::size(pending);
   std::vector<format::SectionEntry> table;
-  std::uint64_t offset = align_up(sizeof(format::FileHeader) + count * sizeof(format::SectionEntry));
+  std::uint64_t offset =
+      align_up(sizeof(format::FileHeader) + count * sizeof(format::SectionEntry));
   for (const auto& p : pending) {
-    table.push_back({format::tag(p.tag), offset, p.size, format::crc32_of(p.data, p.size), p.element_size});
+    table.push_back(
+        {format::tag(p.tag), offset, p.size, format::crc32_of(p.data, p.size), p.element_size});
     offset = align_up(offset + p.size);
   }
-  format::FileHeader header{format::kMagic, kDatabaseVersion, format::kByteOrderMark, offset, count,
-                            format::crc32_of(table.data(), table.size() * sizeof(format::SectionEntry))};
+  format::FileHeader header{
+      format::kMagic,
+      kDatabaseVersion,
+      format::kByteOrderMark,
+      offset,
+      count,
+      format::crc32_of(table.data(), table.size() * sizeof(format::SectionEntry))};
 
   const std::string tmp = path + ".part";
   {
     std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
     if (!out) throw InputError(path, "cannot create the database file");
     out.write(reinterpret_cast<const char*>(&header), sizeof header);
-    out.write(reinterpret_cast<const char*>(table.data()), static_cast<std::streamsize>(table.size() * sizeof(table[0])));
+    out.write(reinterpret_cast<const char*>(table.data()),
+              static_cast<std::streamsize>(table.size() * sizeof(table[0])));
     static const char zeros[format::kAlignment] = {};
     std::uint64_t written = sizeof header + table.size() * sizeof(table[0]);
     for (size_t i = 0; i < count; ++i) {
       out.write(zeros, static_cast<std::streamsize>(table[i].offset - written));
-      out.write(static_cast<const char*>(pending[i].data), static_cast<std::streamsize>(pending[i].size));
+      out.write(static_cast<const char*>(pending[i].data),
+                static_cast<std::streamsize>(pending[i].size));
       written = table[i].offset + pending[i].size;
     }
     out.write(zeros, static_cast<std::streamsize>(offset - written));

@@ -13,12 +13,12 @@ struct DatabaseContents {
   std::vector<ClipInfo> clips;
   std::vector<View> views;
   std::vector<FrameRecord> frames;
-  std::vector<float> joints;                      // frames * 15 * 3
-  std::vector<float> rotations;                   // quaternions * 4 (w, x, y, z)
-  std::vector<float> projections;                 // projections * kPoseDims, sorted by cluster
+  std::vector<float> joints;       // frames * 15 * 3
+  std::vector<float> rotations;    // quaternions * 4 (w, x, y, z)
+  std::vector<float> projections;  // projections * kPoseDims, sorted by cluster
   std::vector<ProjectionRecord> projection_records;
-  std::vector<float> centroids;                   // clusters * kPoseDims
-  std::vector<std::uint32_t> cluster_begin;       // clusters + 1
+  std::vector<float> centroids;              // clusters * kPoseDims
+  std::vector<std::uint32_t> cluster_begin;  // clusters + 1
 };
 
 // Writes through a temporary file renamed into place; throws InputError naming the file when it

@@ -12,12 +12,17 @@ struct Limb {
   float length_m;  // canonical length (CMU train medians, ../shared/data/mocap/bandai/README.md)
 };
 
-// Limbs whose 2D length can only shrink under projection; the one that shrinks least sets the scale.
+// Limbs whose 2D length can only shrink under projection; the one that shrinks least sets the
+// scale.
 constexpr Limb kLimbs[] = {
-    {Joint::right_shoulder, Joint::right_elbow, 0.289f}, {Joint::left_shoulder, Joint::left_elbow, 0.289f},
-    {Joint::right_elbow, Joint::right_wrist, 0.196f},    {Joint::left_elbow, Joint::left_wrist, 0.196f},
-    {Joint::right_hip, Joint::right_knee, 0.412f},       {Joint::left_hip, Joint::left_knee, 0.412f},
-    {Joint::right_knee, Joint::right_ankle, 0.423f},     {Joint::left_knee, Joint::left_ankle, 0.423f},
+    {Joint::right_shoulder, Joint::right_elbow, 0.289f},
+    {Joint::left_shoulder, Joint::left_elbow, 0.289f},
+    {Joint::right_elbow, Joint::right_wrist, 0.196f},
+    {Joint::left_elbow, Joint::left_wrist, 0.196f},
+    {Joint::right_hip, Joint::right_knee, 0.412f},
+    {Joint::left_hip, Joint::left_knee, 0.412f},
+    {Joint::right_knee, Joint::right_ankle, 0.423f},
+    {Joint::left_knee, Joint::left_ankle, 0.423f},
     {Joint::root, Joint::neck, 0.419f},
 };
 
@@ -37,14 +42,17 @@ float limb_scale(std::span<const glm::vec2, kBodyJoints> points) {
   float best = 0.0f;
   for (const Limb& l : kLimbs) {
     const glm::vec2 a = points[index(l.a)], b = points[index(l.b)];
-    if (present(a) && present(b)) best = std::max(best, std::hypot(a.x - b.x, a.y - b.y) / l.length_m);
+    if (present(a) && present(b))
+      best = std::max(best, std::hypot(a.x - b.x, a.y - b.y) / l.length_m);
   }
   return best;  // image units per metre
 }
 
 }  // namespace
 
-std::string_view scaling_name(Scaling s) { return s == Scaling::bbox_height ? "bbox_height" : "bone_length"; }
+std::string_view scaling_name(Scaling s) {
+  return s == Scaling::bbox_height ? "bbox_height" : "bone_length";
+}
 
 bool parse_scaling(std::string_view text, Scaling& out) {
   if (text == "bbox_height" || text == "bbox") return out = Scaling::bbox_height, true;
@@ -52,7 +60,8 @@ bool parse_scaling(std::string_view text, Scaling& out) {
   return false;
 }
 
-bool normalize_pose(std::span<const glm::vec2, kBodyJoints> points, Scaling scaling, PoseVector& out) {
+bool normalize_pose(std::span<const glm::vec2, kBodyJoints> points, Scaling scaling,
+                    PoseVector& out) {
   const glm::vec2 root = points[index(Joint::root)];
   if (!present(root)) return false;
   int count = 0;

@@ -27,6 +27,7 @@ bool parse_scaling(std::string_view text, Scaling& out);
 // Normalises 15 image points (x right, y down; NaN = missing). Missing joints come out as NaN.
 // Returns false when the pose cannot be normalised (root missing, or fewer than 3 joints, or a
 // degenerate extent); `out` is then unspecified.
-bool normalize_pose(std::span<const glm::vec2, kBodyJoints> points, Scaling scaling, PoseVector& out);
+bool normalize_pose(std::span<const glm::vec2, kBodyJoints> points, Scaling scaling,
+                    PoseVector& out);
 
 }  // namespace mocap::posedb

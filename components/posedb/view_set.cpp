@@ -16,7 +16,8 @@ CameraPose camera_pose(const View& view, float root_height_m) {
   const glm::vec3 forward = glm::normalize(-position);  // towards the root at the origin
   const glm::vec3 world_up(0.0f, 1.0f, 0.0f);
   glm::vec3 right = glm::cross(forward, world_up);
-  if (glm::length(right) < 1e-6f) throw std::invalid_argument("camera looks straight down: no yaw is defined");
+  if (glm::length(right) < 1e-6f)
+    throw std::invalid_argument("camera looks straight down: no yaw is defined");
   right = glm::normalize(right);
   const glm::vec3 down = glm::cross(forward, right);
   // Rows of the world-to-camera matrix are the camera axes expressed in the world.
@@ -28,14 +29,16 @@ CameraPose camera_pose(const View& view, float root_height_m) {
 }
 
 std::vector<View> make_views(const ViewSetOptions& o) {
-  if (o.yaw_steps < 1 || o.yaw_steps > 3600) throw std::invalid_argument("yaw steps must be 1 to 3600");
+  if (o.yaw_steps < 1 || o.yaw_steps > 3600)
+    throw std::invalid_argument("yaw steps must be 1 to 3600");
   if (o.heights_m.empty()) throw std::invalid_argument("at least one camera height is needed");
   if (!(o.distance_m > 0.1f)) throw std::invalid_argument("camera distance must be above 0.1 m");
   std::vector<View> views;
   for (float h : o.heights_m) {
     const float pitch = glm::degrees(std::atan2(h - o.root_height_m, o.distance_m));
     for (int y = 0; y < o.yaw_steps; ++y) {
-      views.push_back({360.0f * static_cast<float>(y) / static_cast<float>(o.yaw_steps), h, o.distance_m, pitch});
+      views.push_back({360.0f * static_cast<float>(y) / static_cast<float>(o.yaw_steps), h,
+                       o.distance_m, pitch});
     }
   }
   return views;

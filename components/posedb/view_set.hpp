@@ -12,14 +12,16 @@ namespace mocap::posedb {
 
 // One virtual camera, placed relative to a person who faces +Z with the root at the origin.
 struct View {
-  float yaw_deg = 0.0f;        // camera azimuth around the person: 0 = in front, 90 = at the person's left
-  float height_m = 1.5f;       // camera height above the floor
-  float distance_m = 4.0f;     // horizontal distance from the person
-  float pitch_deg = 0.0f;      // derived: downward angle of the line of sight to the root (positive = down)
+  float yaw_deg =
+      0.0f;  // camera azimuth around the person: 0 = in front, 90 = at the person's left
+  float height_m = 1.5f;    // camera height above the floor
+  float distance_m = 4.0f;  // horizontal distance from the person
+  float pitch_deg =
+      0.0f;  // derived: downward angle of the line of sight to the root (positive = down)
 };
 
 struct ViewSetOptions {
-  int yaw_steps = 30;                               // 12 degree steps, as the paper
+  int yaw_steps = 30;                                       // 12 degree steps, as the paper
   std::vector<float> heights_m = {1.5f, 2.5f, 4.0f, 6.0f};  // 1.5 m is the paper's camera
   float distance_m = 4.0f;
   // Height of the root (mid-hips) above the floor that camera heights are measured against.

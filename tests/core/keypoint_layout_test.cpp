@@ -63,8 +63,8 @@ TEST(KeypointLayout, Coco17DerivesNeckHeadAndRoot) {
 
 TEST(KeypointLayout, MissingKeypointsGiveMissingJoints) {
   auto xyc = coco_points();
-  xyc[3 * 3 + 2] = 0.0f;                                 // left ear missing: head from the right ear
-  xyc[3 * 11 + 2] = 0.0f;                                // left hip missing: no root
+  xyc[3 * 3 + 2] = 0.0f;   // left ear missing: head from the right ear
+  xyc[3 * 11 + 2] = 0.0f;  // left hip missing: no root
   xyc[3 * 9] = std::numeric_limits<float>::quiet_NaN();  // left wrist NaN
   std::vector<float> body(kBodyJoints * 3);
   to_body15(layout(LayoutId::coco17), xyc, body);

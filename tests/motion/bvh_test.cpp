@@ -15,9 +15,12 @@ namespace {
 
 // Two joints with different channel orders, an End Site, tabs, CRLF and exponent notation.
 const char* kSmall =
-    "HIERARCHY\r\nROOT Hips\r\n{\r\n\tOFFSET 0 0 0\r\n\tCHANNELS 6 Xposition Yposition Zposition Zrotation "
-    "Yrotation Xrotation\r\n\tJOINT Chest\r\n\t{\r\n\t\tOFFSET 0 1.0e1 0\r\n\t\tCHANNELS 3 Zrotation Xrotation "
-    "Yrotation\r\n\t\tEnd Site\r\n\t\t{\r\n\t\t\tOFFSET 0 5 0\r\n\t\t}\r\n\t}\r\n}\r\nMOTION\r\nFrames:\t2\r\n"
+    "HIERARCHY\r\nROOT Hips\r\n{\r\n\tOFFSET 0 0 0\r\n\tCHANNELS 6 Xposition Yposition Zposition "
+    "Zrotation "
+    "Yrotation Xrotation\r\n\tJOINT Chest\r\n\t{\r\n\t\tOFFSET 0 1.0e1 0\r\n\t\tCHANNELS 3 "
+    "Zrotation Xrotation "
+    "Yrotation\r\n\t\tEnd Site\r\n\t\t{\r\n\t\t\tOFFSET 0 5 "
+    "0\r\n\t\t}\r\n\t}\r\n}\r\nMOTION\r\nFrames:\t2\r\n"
     "Frame Time: .0333333\r\n1 2 3 10 20 30 0 90 0\r\n-1 +2 3.5e-1 0 0 0 45 0 0\r\n";
 
 TEST(Bvh, ParsesHierarchyAndMotion) {
@@ -63,7 +66,8 @@ TEST(Bvh, EulerConversionReproducesTheMotion) {
   for (int f = 0; f < a.frame_count; ++f) {
     forward_kinematics(a, f, ga);
     forward_kinematics(b, f, gb);
-    for (int j = 0; j < a.joint_count(); ++j) EXPECT_NEAR(glm::distance(ga.position[j], gb.position[j]), 0.0f, 1e-4);
+    for (int j = 0; j < a.joint_count(); ++j)
+      EXPECT_NEAR(glm::distance(ga.position[j], gb.position[j]), 0.0f, 1e-4);
   }
 }
 
@@ -80,15 +84,22 @@ void expect_error(const std::string& text, const std::string& fragment) {
 TEST(Bvh, MalformedInputNamesFileAndLine) {
   const std::string good = kSmall;
   expect_error("", "unexpected end of file");
-  expect_error("HIERARCHY\nROOT Hips\n{\nOFFSET 0 0\n", "bad.bvh:5: unexpected end of file, expected OFFSET z");
-  expect_error("HIERARCHY\nROOT Hips\n{\nOFFSET 0 0 x\n", "bad.bvh:4: expected a number for OFFSET z");
+  expect_error("HIERARCHY\nROOT Hips\n{\nOFFSET 0 0\n",
+               "bad.bvh:5: unexpected end of file, expected OFFSET z");
+  expect_error("HIERARCHY\nROOT Hips\n{\nOFFSET 0 0 x\n",
+               "bad.bvh:4: expected a number for OFFSET z");
   expect_error(good.substr(0, good.size() - 12), "truncated");
   expect_error(good + "7 7 7\n", "more values");
-  expect_error("HIERARCHY\nROOT Hips\n{\nOFFSET 0 0 0\nCHANNELS 1 Wrotation\n}\nMOTION\n", "bad.bvh:5: unknown channel");
-  expect_error("HIERARCHY\nROOT Hips\n{\nOFFSET 0 0 0\nCHANNELS 1 Xrotation\n}\nMOTION\nFrames: 5000000\nFrame Time: 1\n1\n",
-               "truncated");
-  expect_error("HIERARCHY\nROOT Hips\n{\nOFFSET 0 0 0\nCHANNELS 1 Xrotation\n}\nMOTION\nFrames: 999999999\nFrame Time: 1\n1\n",
-               "implausible frame count");
+  expect_error("HIERARCHY\nROOT Hips\n{\nOFFSET 0 0 0\nCHANNELS 1 Wrotation\n}\nMOTION\n",
+               "bad.bvh:5: unknown channel");
+  expect_error(
+      "HIERARCHY\nROOT Hips\n{\nOFFSET 0 0 0\nCHANNELS 1 Xrotation\n}\nMOTION\nFrames: "
+      "5000000\nFrame Time: 1\n1\n",
+      "truncated");
+  expect_error(
+      "HIERARCHY\nROOT Hips\n{\nOFFSET 0 0 0\nCHANNELS 1 Xrotation\n}\nMOTION\nFrames: "
+      "999999999\nFrame Time: 1\n1\n",
+      "implausible frame count");
   expect_error("HIERARCHY\nROOT a\n{\nOFFSET nan 0 0\n", "expected a number");
 }
 
@@ -111,11 +122,13 @@ TEST(Bvh, RandomBytesNeverCrash) {
 TEST(Bvh, EverySharedMocapFileParses) {
   MOCAP_REQUIRE_SHARED("mocap");
   int files = 0;
-  for (const auto& e : std::filesystem::recursive_directory_iterator(test::shared_data() / "mocap")) {
+  for (const auto& e :
+       std::filesystem::recursive_directory_iterator(test::shared_data() / "mocap")) {
     if (e.path().extension() != ".bvh") continue;
     const Clip c = read_bvh(e.path().string());
     EXPECT_GT(c.frame_count, 0) << e.path();
-    EXPECT_EQ(c.values.size(), static_cast<size_t>(c.frame_count) * c.skeleton.channel_count) << e.path();
+    EXPECT_EQ(c.values.size(), static_cast<size_t>(c.frame_count) * c.skeleton.channel_count)
+        << e.path();
     ++files;
   }
   EXPECT_GE(files, 60);
@@ -132,9 +145,7 @@ TEST(Bvh, RealFileRoundTrip) {
   EXPECT_EQ(a.skeleton.joint_count(), b.skeleton.joint_count());
 }
 
-TEST(Bvh, MissingFileIsAClearError) {
-  EXPECT_THROW(read_bvh("/nonexistent/x.bvh"), InputError);
-}
+TEST(Bvh, MissingFileIsAClearError) { EXPECT_THROW(read_bvh("/nonexistent/x.bvh"), InputError); }
 
 }  // namespace
 }  // namespace mocap::motion

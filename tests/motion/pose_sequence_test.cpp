@@ -2,10 +2,10 @@
 
 #include <gtest/gtest.h>
 
-#include "motion/body_mapping.hpp"
-#include "motion/asf_amc.hpp"
-#include "motion/bvh.hpp"
 #include "cmu_asf_fixture.hpp"
+#include "motion/asf_amc.hpp"
+#include "motion/body_mapping.hpp"
+#include "motion/bvh.hpp"
 #include "support/shared_data.hpp"
 
 namespace mocap::motion {
@@ -16,7 +16,8 @@ PoseSequence load(const std::string& relative) {
 }
 
 bool has_position_channel(const SkeletonJoint& j) {
-  return std::any_of(j.channels.begin(), j.channels.end(), [](Channel c) { return !is_rotation(c); });
+  return std::any_of(j.channels.begin(), j.channels.end(),
+                     [](Channel c) { return !is_rotation(c); });
 }
 
 // Bone lengths (parent to child distance) stay constant over a clip after FK, for each family.
@@ -25,7 +26,8 @@ void expect_constant_bones(const PoseSequence& p, float tolerance) {
   GlobalPose g;
   forward_kinematics(p, 0, g);
   std::vector<float> first(p.joint_count());
-  for (int j = 1; j < p.joint_count(); ++j) first[j] = glm::distance(g.position[j], g.position[p.skeleton.joints[j].parent]);
+  for (int j = 1; j < p.joint_count(); ++j)
+    first[j] = glm::distance(g.position[j], g.position[p.skeleton.joints[j].parent]);
   for (int f = 1; f < p.frame_count; f += 7) {
     forward_kinematics(p, f, g);
     for (int j = 1; j < p.joint_count(); ++j) {
@@ -102,7 +104,8 @@ void expect_plausible_body(const std::string& relative, Family family, int frame
   std::array<glm::vec3, kBodyJoints> b;
   body_positions(m, g, b);
   const float thigh = glm::distance(b[index(Joint::left_hip)], b[index(Joint::left_knee)]);
-  const float shoulders = glm::distance(b[index(Joint::left_shoulder)], b[index(Joint::right_shoulder)]);
+  const float shoulders =
+      glm::distance(b[index(Joint::left_shoulder)], b[index(Joint::right_shoulder)]);
   const float head_above_root = b[index(Joint::head)].y - b[index(Joint::root)].y;
   EXPECT_GT(thigh, 0.3f) << relative;
   EXPECT_LT(thigh, 0.5f) << relative;
@@ -132,7 +135,8 @@ TEST(BodyMapping, CmuAsfAmcIsRecognisedAndScaledToMetres) {
   std::array<glm::vec3, kBodyJoints> b;
   body_positions(m, g, b);
   // Femur length 7.2 ASF units = 0.406 m; the head top is above the neck, the left hand on +X.
-  EXPECT_NEAR(glm::distance(b[index(Joint::left_hip)], b[index(Joint::left_knee)]), 7.2f * 0.056444f, 1e-3);
+  EXPECT_NEAR(glm::distance(b[index(Joint::left_hip)], b[index(Joint::left_knee)]),
+              7.2f * 0.056444f, 1e-3);
   EXPECT_GT(b[index(Joint::head)].y, b[index(Joint::neck)].y);
   EXPECT_GT(b[index(Joint::left_wrist)].x, b[index(Joint::right_wrist)].x);
 }

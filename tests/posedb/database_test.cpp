@@ -7,10 +7,10 @@
 #include <gtest/gtest.h>
 
 #include "core/input_error.hpp"
+#include "motion/cmu_asf_fixture.hpp"
 #include "posedb/builder.hpp"
 #include "posedb/cluster_search.hpp"
 #include "posedb/exact_search.hpp"
-#include "motion/cmu_asf_fixture.hpp"
 #include "support/shared_data.hpp"
 
 namespace mocap::posedb {
@@ -29,10 +29,11 @@ class DatabaseTest : public ::testing::Test {
     options.clusters = 64;
     options.views.yaw_steps = 12;
     BuildReport report;
-    contents_ = std::make_unique<DatabaseContents>(build_database(
-        {(mocap / "cmu31/08_01.bvh").string(), (mocap / "cmu31/09_10.bvh").string(),
-         (mocap / "bandai/dataset-1/dataset-1_bow_normal_001.bvh").string(), (mocap / "missing.bvh").string()},
-        options, {}, report));
+    contents_ = std::make_unique<DatabaseContents>(
+        build_database({(mocap / "cmu31/08_01.bvh").string(), (mocap / "cmu31/09_10.bvh").string(),
+                        (mocap / "bandai/dataset-1/dataset-1_bow_normal_001.bvh").string(),
+                        (mocap / "missing.bvh").string()},
+                       options, {}, report));
     report_ = report;
     path_ = dir_->file("small.mdb");
     write_database(*contents_, path_);
@@ -45,12 +46,14 @@ class DatabaseTest : public ::testing::Test {
     if (!contents_) GTEST_SKIP() << "shared mocap data absent (../shared/data/mocap)";
   }
 
-  static std::string corrupted_copy(const std::string& name, const std::function<void(std::string&)>& edit) {
+  static std::string corrupted_copy(const std::string& name,
+                                    const std::function<void(std::string&)>& edit) {
     std::ifstream in(path_, std::ios::binary);
     std::string bytes((std::istreambuf_iterator<char>(in)), {});
     edit(bytes);
     const std::string out = dir_->file(name);
-    std::ofstream(out, std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+    std::ofstream(out, std::ios::binary)
+        .write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
     return out;
   }
 
@@ -64,7 +67,7 @@ TEST_F(DatabaseTest, BuildDropsReferenceAndBlankFramesAndReportsBadFiles) {
   EXPECT_EQ(report_.files_read, 3u);
   ASSERT_EQ(report_.skipped.size(), 1u);
   EXPECT_NE(report_.skipped[0].find("missing.bvh"), std::string::npos);
-  EXPECT_EQ(report_.blank_frames_dropped, 4u);   // 09_10 frames 1-4 are all zero
+  EXPECT_EQ(report_.blank_frames_dropped, 4u);      // 09_10 frames 1-4 are all zero
   EXPECT_EQ(report_.reference_frames_dropped, 2u);  // the two cgspeed T-poses; Bandai has none
   // 08_01: 277 motion frames at 120 fps -> 56 at 24 fps; 09_10: frames 5..132 -> 26;
   // Bandai bow normal: frames @24 from clips.tsv.
@@ -102,13 +105,15 @@ TEST_F(DatabaseTest, EveryProjectionFindsItself) {
   std::mt19937 rng(1);
   for (int trial = 0; trial < 300; ++trial) {
     const std::size_t i = rng() % db.projections().rows;
-    for (const SearchIndex* index : {static_cast<const SearchIndex*>(&exact), static_cast<const SearchIndex*>(&clusters)}) {
+    for (const SearchIndex* index :
+         {static_cast<const SearchIndex*>(&exact), static_cast<const SearchIndex*>(&clusters)}) {
       index->search(db.projections().row(i), nullptr, 1, found);
       ASSERT_EQ(found.size(), 1u);
       EXPECT_EQ(found[0].distance, 0.0f) << index->name();
       // Identical rows may exist (a still pose); then any of them is a correct answer.
       if (found[0].index != i) {
-        EXPECT_TRUE(std::equal(db.projections().row(i), db.projections().row(i) + kPoseDims, db.projections().row(found[0].index)));
+        EXPECT_TRUE(std::equal(db.projections().row(i), db.projections().row(i) + kPoseDims,
+                               db.projections().row(found[0].index)));
       }
     }
   }
@@ -125,11 +130,14 @@ void expect_refused(const std::string& path, const std::string& fragment) {
 }
 
 TEST_F(DatabaseTest, CorruptedTruncatedAndForeignFilesAreRefused) {
-  expect_refused(corrupted_copy("trunc.mdb", [](std::string& b) { b.resize(b.size() / 2); }), "truncated");
+  expect_refused(corrupted_copy("trunc.mdb", [](std::string& b) { b.resize(b.size() / 2); }),
+                 "truncated");
   expect_refused(corrupted_copy("empty.mdb", [](std::string& b) { b.clear(); }), "too small");
-  expect_refused(corrupted_copy("magic.mdb", [](std::string& b) { b[0] = 'X'; }), "not a mocap pose database");
+  expect_refused(corrupted_copy("magic.mdb", [](std::string& b) { b[0] = 'X'; }),
+                 "not a mocap pose database");
   expect_refused(corrupted_copy("version.mdb", [](std::string& b) { b[8] = 9; }), "newer");
-  expect_refused(corrupted_copy("flip.mdb", [](std::string& b) { b[b.size() - 100] ^= 0x40; }), "checksum");
+  expect_refused(corrupted_copy("flip.mdb", [](std::string& b) { b[b.size() - 100] ^= 0x40; }),
+                 "checksum");
   expect_refused(corrupted_copy("table.mdb", [](std::string& b) { b[40] ^= 1; }), "checksum");
   expect_refused(dir_->file("absent.mdb"), "cannot open");
   const std::string bvh = (test::shared_data() / "mocap/cmu31/08_01.bvh").string();
@@ -154,7 +162,8 @@ TEST(DatabaseFiles, CollectFindsBvhAndRejectsOthers) {
   const auto files = collect_motion_files({(test::shared_data() / "mocap/cmu_daz").string()});
   EXPECT_EQ(files.size(), 5u);
   EXPECT_THROW(collect_motion_files({"/nonexistent/folder"}), InputError);
-  EXPECT_THROW(collect_motion_files({(test::shared_data() / "mocap/README.md").string()}), InputError);
+  EXPECT_THROW(collect_motion_files({(test::shared_data() / "mocap/README.md").string()}),
+               InputError);
 }
 
 }  // namespace

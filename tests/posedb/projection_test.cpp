@@ -62,7 +62,9 @@ TEST(Projection, PitchedCameraLooksAtTheRoot) {
   // A point above the root appears above the image centre, foreshortened by the 45 degree tilt.
   project_body(one_point_body({0.0f, 1.0f, 0.0f}), cam, out);
   EXPECT_LT(out[0].y, 0.0f);
-  EXPECT_NEAR(out[0].y, -std::cos(glm::radians(45.0f)) / (std::sqrt(32.0f) - std::sin(glm::radians(45.0f))), 1e-5);
+  EXPECT_NEAR(out[0].y,
+              -std::cos(glm::radians(45.0f)) / (std::sqrt(32.0f) - std::sin(glm::radians(45.0f))),
+              1e-5);
 }
 
 std::array<glm::vec2, kBodyJoints> random_pose(std::mt19937& rng) {
@@ -95,7 +97,8 @@ TEST(Normalization, BoxHeightIsOneAndRootIsOrigin) {
   PoseVector n;
   ASSERT_TRUE(normalize_pose(a, Scaling::bbox_height, n));
   float lo = 0, hi = 0;  // the root (0, 0) is part of the box
-  for (int j = 0; j < kBodyJoints - 1; ++j) lo = std::min(lo, n[2 * j + 1]), hi = std::max(hi, n[2 * j + 1]);
+  for (int j = 0; j < kBodyJoints - 1; ++j)
+    lo = std::min(lo, n[2 * j + 1]), hi = std::max(hi, n[2 * j + 1]);
   EXPECT_NEAR(hi - lo, 1.0f, 1e-5);
 }
 

@@ -92,10 +92,12 @@ bool Args::parse(int argc, char** argv, int& exit_code) {
       continue;
     }
     if (!inline_value) {
-      if (i + 1 >= argc) return fail("option '--" + name + "' needs a value (" + it->second.value_name + ")");
+      if (i + 1 >= argc)
+        return fail("option '--" + name + "' needs a value (" + it->second.value_name + ")");
       value = argv[++i];
     }
-    if (!it->second.repeatable && values_.count(name)) return fail("option '--" + name + "' given twice");
+    if (!it->second.repeatable && values_.count(name))
+      return fail("option '--" + name + "' given twice");
     values_[name].push_back(value);
   }
   if (has("help")) {
@@ -122,13 +124,15 @@ bool Args::has(const std::string& name) const { return values_.count(name) > 0; 
 
 std::string Args::get(const std::string& name) const {
   if (const auto it = values_.find(name); it != values_.end()) return it->second.back();
-  if (const auto it = specs_.find(name); it != specs_.end() && it->second.fallback) return *it->second.fallback;
+  if (const auto it = specs_.find(name); it != specs_.end() && it->second.fallback)
+    return *it->second.fallback;
   return {};
 }
 
 std::vector<std::string> Args::all(const std::string& name) const {
   if (const auto it = values_.find(name); it != values_.end()) return it->second;
-  if (const auto it = specs_.find(name); it != specs_.end() && it->second.fallback) return {*it->second.fallback};
+  if (const auto it = specs_.find(name); it != specs_.end() && it->second.fallback)
+    return {*it->second.fallback};
   return {};
 }
 

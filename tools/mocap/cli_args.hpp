@@ -28,8 +28,8 @@ class Args {
   std::string get(const std::string& name) const;
   std::vector<std::string> all(const std::string& name) const;
   bool has(const std::string& name) const;
-  double number(const std::string& name) const;   // throws InputError naming the option
-  long integer(const std::string& name) const;    // likewise
+  double number(const std::string& name) const;  // throws InputError naming the option
+  long integer(const std::string& name) const;   // likewise
   const std::vector<std::string>& positionals() const { return positionals_; }
   std::string help() const;
 

@@ -46,7 +46,8 @@ std::string joined_command(const char* name, int argc, char** argv) {
 }
 
 // Keeps the files that a folder's splits.txt ("train 01_01.bvh" lines) assigns to `split`.
-std::vector<std::string> filter_split(const std::vector<std::string>& inputs, const std::vector<std::string>& files,
+std::vector<std::string> filter_split(const std::vector<std::string>& inputs,
+                                      const std::vector<std::string>& files,
                                       const std::string& split) {
   std::map<std::string, std::string> split_of;
   for (const auto& in : inputs) {
@@ -66,8 +67,10 @@ std::vector<std::string> filter_split(const std::vector<std::string>& inputs, co
 
 int build(int argc, char** argv) {
   Args args("mocap db build PATH... --out FILE [options]",
-            "Builds the pose database from mocap files (BVH, or ASF/AMC) and folders of them: every frame is\n"
-            "resampled, mapped to the 15-joint body and projected through virtual cameras at several yaws\n"
+            "Builds the pose database from mocap files (BVH, or ASF/AMC) and folders of them: "
+            "every frame is\n"
+            "resampled, mapped to the 15-joint body and projected through virtual cameras at "
+            "several yaws\n"
             "and heights; the normalised projections are clustered for fast search.");
   args.positional("PATH", "BVH/AMC files or folders (searched recursively)", true)
       .option("out", "FILE", "database file to write")
@@ -75,7 +78,8 @@ int build(int argc, char** argv) {
       .option("yaw-steps", "N", "camera yaw steps around the person (30 = every 12 degrees)", "30")
       .option("heights", "LIST", "camera heights in metres, comma-separated", "1.5,2.5,4,6")
       .option("distance", "M", "horizontal camera distance in metres", "4")
-      .option("scaling", "MODE", "2D normalisation: bbox_height (paper) or bone_length", "bbox_height")
+      .option("scaling", "MODE", "2D normalisation: bbox_height (paper) or bone_length",
+              "bbox_height")
       .option("clusters", "N", "k-means clusters (0 = about sqrt(projections))", "0")
       .option("seed", "N", "random seed for k-means", "1")
       .option("threads", "N", "worker threads", "2")
@@ -90,7 +94,8 @@ int build(int argc, char** argv) {
   options.views.heights_m = parse_float_list(args.get("heights"), "heights");
   options.views.distance_m = static_cast<float>(args.number("distance"));
   if (!posedb::parse_scaling(args.get("scaling"), options.scaling)) {
-    throw InputError("--scaling", "expected bbox_height or bone_length, got '" + args.get("scaling") + "'");
+    throw InputError("--scaling",
+                     "expected bbox_height or bone_length, got '" + args.get("scaling") + "'");
   }
   options.clusters = static_cast<int>(args.integer("clusters"));
   options.seed = static_cast<std::uint64_t>(args.integer("seed"));
@@ -110,10 +115,11 @@ int build(int argc, char** argv) {
   posedb::write_database(db, args.get("out"));
   bar.finish();
   for (const auto& s : report.skipped) std::cerr << "skipped: " << s << "\n";
-  std::cout << "wrote " << args.get("out") << ": " << db.clips.size() << " clips, " << db.frames.size()
-            << " frames, " << db.views.size() << " views, " << db.projection_records.size() << " projections, "
-            << db.cluster_begin.size() - 1 << " clusters in " << std::fixed << std::setprecision(1)
-            << db.build.build_seconds << " s";
+  std::cout << "wrote " << args.get("out") << ": " << db.clips.size() << " clips, "
+            << db.frames.size() << " frames, " << db.views.size() << " views, "
+            << db.projection_records.size() << " projections, " << db.cluster_begin.size() - 1
+            << " clusters in " << std::fixed << std::setprecision(1) << db.build.build_seconds
+            << " s";
   if (!report.skipped.empty()) std::cout << " (" << report.skipped.size() << " file(s) skipped)";
   std::cout << "\n";
   return report.skipped.empty() ? 0 : 3;
@@ -126,7 +132,10 @@ json info_json(const posedb::Database& db) {
     auto& [count, frames] = families[c.family];
     ++count;
     frames += c.frame_count;
-    clips.push_back({{"name", c.name}, {"family", c.family}, {"frames", c.frame_count}, {"source_fps", c.source_fps}});
+    clips.push_back({{"name", c.name},
+                     {"family", c.family},
+                     {"frames", c.frame_count},
+                     {"source_fps", c.source_fps}});
   }
   json fam = json::object();
   for (const auto& [name, cf] : families) fam[name] = {{"clips", cf.first}, {"frames", cf.second}};
@@ -149,8 +158,11 @@ json info_json(const posedb::Database& db) {
 }
 
 int info(int argc, char** argv) {
-  Args args("mocap db info FILE [--json] [--clips]", "Prints what a pose database holds and how it was built.");
-  args.positional("FILE", "pose database").flag("json", "print JSON").flag("clips", "list every clip");
+  Args args("mocap db info FILE [--json] [--clips]",
+            "Prints what a pose database holds and how it was built.");
+  args.positional("FILE", "pose database")
+      .flag("json", "print JSON")
+      .flag("clips", "list every clip");
   int code = 0;
   if (!args.parse(argc, argv, code)) return code;
   const posedb::Database db = posedb::Database::open(args.positionals()[0]);
@@ -168,23 +180,28 @@ int info(int argc, char** argv) {
             << b.views.heights_m.size() << " camera heights";
   for (float h : b.views.heights_m) std::cout << " " << h;
   std::cout << " m, " << b.views.distance_m << " m away)\n"
-            << "projections  " << db.projections().rows << " x " << db.projections().dim << " floats, "
-            << posedb::scaling_name(b.scaling) << " normalisation\n"
-            << "clusters     " << db.centroids().rows << " (largest " << j["largest_cluster"] << ")\n"
+            << "projections  " << db.projections().rows << " x " << db.projections().dim
+            << " floats, " << posedb::scaling_name(b.scaling) << " normalisation\n"
+            << "clusters     " << db.centroids().rows << " (largest " << j["largest_cluster"]
+            << ")\n"
             << "index        " << j["index"].get<std::string>() << "\n"
             << "families    ";
-  for (const auto& [name, f] : j["families"].items()) std::cout << " " << name << ": " << f["clips"] << " clips, " << f["frames"] << " frames;";
-  std::cout << "\nbuilt        " << b.created << " in " << b.build_seconds << " s, seed " << b.seed << "\n"
+  for (const auto& [name, f] : j["families"].items())
+    std::cout << " " << name << ": " << f["clips"] << " clips, " << f["frames"] << " frames;";
+  std::cout << "\nbuilt        " << b.created << " in " << b.build_seconds << " s, seed " << b.seed
+            << "\n"
             << "command      " << b.command << "\n";
   if (args.has("clips")) {
-    for (const auto& c : db.clips()) std::cout << "  " << c.name << "  " << c.family << "  " << c.frame_count << " frames\n";
+    for (const auto& c : db.clips())
+      std::cout << "  " << c.name << "  " << c.family << "  " << c.frame_count << " frames\n";
   }
   return 0;
 }
 
 // A query pose: {"layout": "COCO-17", "keypoints": [[x, y, c], ...]} (or a flat list), or
 // {"joints": {"head": [x, y], ...}} with the 15 body joint names; absent joints are missing.
-std::array<glm::vec2, kBodyJoints> parse_query_pose(const std::string& text, const std::string& where) {
+std::array<glm::vec2, kBodyJoints> parse_query_pose(const std::string& text,
+                                                    const std::string& where) {
   json j;
   try {
     j = json::parse(text);
@@ -204,7 +221,8 @@ std::array<glm::vec2, kBodyJoints> parse_query_pose(const std::string& text, con
       return points;
     }
     const KeypointLayout* layout = find_layout(j.at("layout").get<std::string>());
-    if (!layout) throw InputError(where, "unknown layout '" + j.at("layout").get<std::string>() + "'");
+    if (!layout)
+      throw InputError(where, "unknown layout '" + j.at("layout").get<std::string>() + "'");
     std::vector<float> flat;
     for (const auto& v : j.at("keypoints")) {
       if (v.is_array()) {
@@ -214,8 +232,10 @@ std::array<glm::vec2, kBodyJoints> parse_query_pose(const std::string& text, con
       }
     }
     if (flat.size() != layout->keypoints.size() * 3) {
-      throw InputError(where, std::string(layout->name) + " needs " + std::to_string(layout->keypoints.size()) +
-                                  " keypoints of (x, y, confidence), got " + std::to_string(flat.size()) + " numbers");
+      throw InputError(where, std::string(layout->name) + " needs " +
+                                  std::to_string(layout->keypoints.size()) +
+                                  " keypoints of (x, y, confidence), got " +
+                                  std::to_string(flat.size()) + " numbers");
     }
     std::array<float, kBodyJoints * 3> body;
     to_body15(*layout, flat, body);
@@ -229,9 +249,12 @@ std::array<glm::vec2, kBodyJoints> parse_query_pose(const std::string& text, con
 int query(int argc, char** argv) {
   Args args("mocap db query FILE (--pose JSON | --pose-file FILE | --self N) [options]",
             "Finds the k nearest database projections of a 2D pose.\n"
-            "A pose is {\"layout\": \"COCO-17\", \"keypoints\": [[x, y, confidence], ...]} in any layout\n"
-            "(COCO-17, BODY_25, BODY_25B, COCO-18, HumanEva-15), or {\"joints\": {\"head\": [x, y], ...}}\n"
-            "with the 15 body joint names; image coordinates, y down. Missing joints are left out of the distance.");
+            "A pose is {\"layout\": \"COCO-17\", \"keypoints\": [[x, y, confidence], ...]} in any "
+            "layout\n"
+            "(COCO-17, BODY_25, BODY_25B, COCO-18, HumanEva-15), or {\"joints\": {\"head\": [x, "
+            "y], ...}}\n"
+            "with the 15 body joint names; image coordinates, y down. Missing joints are left out "
+            "of the distance.");
   args.positional("FILE", "pose database")
       .option("pose", "JSON", "the pose, inline")
       .option("pose-file", "FILE", "the pose, from a file")
@@ -248,9 +271,11 @@ int query(int argc, char** argv) {
   if (args.has("self")) {
     const long n = args.integer("self");
     if (n < 0 || static_cast<std::size_t>(n) >= db.projections().rows) {
-      throw InputError("--self", "projection number out of range (0 to " + std::to_string(db.projections().rows - 1) + ")");
+      throw InputError("--self", "projection number out of range (0 to " +
+                                     std::to_string(db.projections().rows - 1) + ")");
     }
-    std::copy_n(db.projections().row(static_cast<std::size_t>(n)), posedb::kPoseDims, query.begin());
+    std::copy_n(db.projections().row(static_cast<std::size_t>(n)), posedb::kPoseDims,
+                query.begin());
   } else {
     std::string text = args.get("pose"), where = "--pose";
     if (args.has("pose-file")) {
@@ -263,7 +288,9 @@ int query(int argc, char** argv) {
     }
     const auto points = parse_query_pose(text, where);
     if (!posedb::normalize_pose(points, db.build_info().scaling, query)) {
-      throw InputError(where, "cannot normalise this pose: the root (mid-hips) and at least 3 joints are needed");
+      throw InputError(
+          where,
+          "cannot normalise this pose: the root (mid-hips) and at least 3 joints are needed");
     }
   }
   posedb::PoseVector weights;
@@ -273,28 +300,36 @@ int query(int argc, char** argv) {
   if (args.get("method") == "exact") {
     index = std::make_unique<posedb::ExactSearch>(db.projections());
   } else if (args.get("method") == "clusters") {
-    index = std::make_unique<posedb::ClusterSearch>(db.projections(), db.centroids(), db.cluster_begin(),
+    index = std::make_unique<posedb::ClusterSearch>(db.projections(), db.centroids(),
+                                                    db.cluster_begin(),
                                                     static_cast<int>(args.integer("probe")));
   } else {
     throw InputError("--method", "expected exact or clusters, got '" + args.get("method") + "'");
   }
   std::vector<posedb::Neighbor> found;
-  index->search(query.data(), weights.data(), static_cast<int>(std::clamp(args.integer("k"), 1L, 10000L)), found);
+  index->search(query.data(), weights.data(),
+                static_cast<int>(std::clamp(args.integer("k"), 1L, 10000L)), found);
   for (size_t r = 0; r < found.size(); ++r) {
     const auto& rec = db.projection_records()[found[r].index];
     const auto& frame = db.frames()[rec.frame];
     const auto& clip = db.clips()[frame.clip];
     const auto& view = db.views()[rec.view];
     if (args.has("json")) {
-      std::cout << json{{"rank", r}, {"projection", found[r].index}, {"distance", found[r].distance},
-                        {"clip", clip.name}, {"clip_frame", frame.clip_frame}, {"frame", rec.frame},
-                        {"yaw_deg", view.yaw_deg}, {"camera_height_m", view.height_m}}
+      std::cout << json{{"rank", r},
+                        {"projection", found[r].index},
+                        {"distance", found[r].distance},
+                        {"clip", clip.name},
+                        {"clip_frame", frame.clip_frame},
+                        {"frame", rec.frame},
+                        {"yaw_deg", view.yaw_deg},
+                        {"camera_height_m", view.height_m}}
                        .dump()
                 << "\n";
     } else {
-      std::cout << std::setw(3) << r << "  distance " << std::setw(10) << std::setprecision(6) << found[r].distance
-                << "  projection " << std::setw(8) << found[r].index << "  " << clip.name << " frame "
-                << frame.clip_frame << "  yaw " << view.yaw_deg << "  camera " << view.height_m << " m\n";
+      std::cout << std::setw(3) << r << "  distance " << std::setw(10) << std::setprecision(6)
+                << found[r].distance << "  projection " << std::setw(8) << found[r].index << "  "
+                << clip.name << " frame " << frame.clip_frame << "  yaw " << view.yaw_deg
+                << "  camera " << view.height_m << " m\n";
     }
   }
   return 0;

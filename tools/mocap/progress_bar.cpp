@@ -29,8 +29,9 @@ void ProgressBar::update(std::string_view stage, double fraction) {
   if (fraction > 0.02 && fraction < 1.0) {
     std::snprintf(eta, sizeof eta, " ETA %.0fs", elapsed * (1.0 - fraction) / fraction);
   }
-  std::fprintf(stderr, "\r%-10s [%s%s] %3d%%%s\033[K", stage_.c_str(), std::string(filled, '#').c_str(),
-               std::string(kWidth - filled, '.').c_str(), static_cast<int>(fraction * 100), eta);
+  std::fprintf(stderr, "\r%-10s [%s%s] %3d%%%s\033[K", stage_.c_str(),
+               std::string(filled, '#').c_str(), std::string(kWidth - filled, '.').c_str(),
+               static_cast<int>(fraction * 100), eta);
   std::fflush(stderr);
   drawn_ = true;
 }
