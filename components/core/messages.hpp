@@ -92,6 +92,31 @@ struct People3D : Message {
   std::vector<Person3D> people;
 };
 
+// A person prepared for the pose database (the scaler fills `normalized`) and matched against
+// it (the matcher fills `candidates`): the message between scaler, matcher and temporal selector.
+inline constexpr int kNormalizedDims = 2 * (kBodyJoints - 1);  // the 14 non-root joints as x, y
+
+struct PoseCandidate {
+  std::uint32_t projection = 0;  // row of the database's projections
+  std::uint32_t frame = 0;       // database frame
+  std::uint32_t view = 0;        // database view
+  float distance = 0;            // squared distance over the joints present
+};
+
+struct PersonMatch {
+  int id = -1;
+  Box2D box;
+  std::array<Keypoint2D, kBodyJoints> body{};       // the 15 body joints, image pixels
+  bool normalized_ok = false;                       // false: too few joints or no root
+  std::array<float, kNormalizedDims> normalized{};  // root-centred, scaled; NaN = missing
+  std::vector<PoseCandidate> candidates;            // nearest first
+};
+
+struct PoseMatches : Message {
+  static constexpr std::string_view kTypeName = "PoseMatches";
+  std::vector<PersonMatch> people;
+};
+
 // Flows through every edge after a stream's last message; a node closes once all its inputs have
 // ended. Node code never sees it: the framework handles it.
 struct EndOfStream : Message {

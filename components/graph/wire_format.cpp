@@ -155,6 +155,34 @@ std::vector<Frame> encode_people_3d(const People3D& m) {
   return frames;
 }
 
+std::vector<Frame> encode_pose_matches(const PoseMatches& m) {
+  Writer meta, body, normalized, candidates;
+  meta.put<std::uint32_t>(static_cast<std::uint32_t>(m.people.size()));
+  for (const PersonMatch& p : m.people) {
+    if (p.candidates.size() > kMaxCandidates) throw WireError("PoseMatches: too many candidates");
+    meta.put<std::int32_t>(p.id);
+    for (float v : {p.box.x, p.box.y, p.box.width, p.box.height}) meta.put(v);
+    meta.put<std::uint32_t>(p.normalized_ok ? 1u : 0u);
+    meta.put<std::uint32_t>(static_cast<std::uint32_t>(p.candidates.size()));
+    for (const Keypoint2D& k : p.body) {
+      for (float v : {k.x, k.y, k.confidence}) body.put(v);
+    }
+    for (float v : p.normalized) normalized.put(v);
+    for (const PoseCandidate& c : p.candidates) {
+      candidates.put(c.projection);
+      candidates.put(c.frame);
+      candidates.put(c.view);
+      candidates.put(c.distance);
+    }
+  }
+  std::vector<Frame> frames;
+  frames.push_back(std::move(meta).frame());
+  frames.push_back(std::move(body).frame());
+  frames.push_back(std::move(normalized).frame());
+  frames.push_back(std::move(candidates).frame());
+  return frames;
+}
+
 std::vector<Frame> encode_stats(const GraphStats& m) {
   nlohmann::json nodes = nlohmann::json::array();
   for (const NodeStats& n : m.nodes) {
@@ -260,6 +288,40 @@ Packet decode_people_3d(const Header& header, std::span<const Frame> payload) {
   return Packet::of<People3D>(std::move(m));
 }
 
+Packet decode_pose_matches(const Header& header, std::span<const Frame> payload) {
+  Reader meta(payload[0], "PoseMatches meta");
+  auto m = with_header<PoseMatches>(header);
+  const auto count = meta.get<std::uint32_t>();
+  if (count > kMaxPeople) throw WireError("PoseMatches: person count beyond the limits");
+  expect_size(payload[0], 4 + std::size_t{count} * 28, "PoseMatches meta");
+  expect_size(payload[1], std::size_t{count} * kBodyJoints * 12, "PoseMatches body");
+  expect_size(payload[2], std::size_t{count} * kNormalizedDims * 4, "PoseMatches normalized");
+  Reader body(payload[1], "PoseMatches body"), normalized(payload[2], "PoseMatches normalized");
+  Reader candidates(payload[3], "PoseMatches candidates");
+  m->people.resize(count);
+  std::size_t total = 0;
+  for (PersonMatch& p : m->people) {
+    p.id = meta.get<std::int32_t>();
+    p.box = {meta.get<float>(), meta.get<float>(), meta.get<float>(), meta.get<float>()};
+    p.normalized_ok = meta.get<std::uint32_t>() != 0;
+    const auto n = meta.get<std::uint32_t>();
+    if (n > kMaxCandidates) throw WireError("PoseMatches: candidate count beyond the limits");
+    total += n;
+    if (total * 16 > payload[3].size) throw WireError("PoseMatches: candidates frame too short");
+    for (Keypoint2D& k : p.body) k = {body.get<float>(), body.get<float>(), body.get<float>()};
+    for (float& v : p.normalized) v = normalized.get<float>();
+    p.candidates.resize(n);
+    for (PoseCandidate& c : p.candidates) {
+      c.projection = candidates.get<std::uint32_t>();
+      c.frame = candidates.get<std::uint32_t>();
+      c.view = candidates.get<std::uint32_t>();
+      c.distance = candidates.get<float>();
+    }
+  }
+  candidates.expect_end();
+  return Packet::of<PoseMatches>(std::move(m));
+}
+
 Packet decode_stats(const Header& header, std::span<const Frame> payload) {
   if (payload[0].size > kMaxStatsBytes) throw WireError("GraphStats: too large");
   auto m = with_header<GraphStats>(header);
@@ -290,6 +352,7 @@ constexpr TypeInfo kTypes[] = {
     {TypeCode::people_2d, People2D::kTypeName, 2},
     {TypeCode::people_3d, People3D::kTypeName, 4},
     {TypeCode::graph_stats, GraphStats::kTypeName, 1},
+    {TypeCode::pose_matches, PoseMatches::kTypeName, 4},
 };
 
 const TypeInfo& info_by_name(std::string_view name) {
@@ -318,6 +381,9 @@ std::vector<Frame> encode(const Packet& packet, std::int64_t send_ns) {
       break;
     case TypeCode::graph_stats:
       payload = encode_stats(static_cast<const GraphStats&>(*packet.message));
+      break;
+    case TypeCode::pose_matches:
+      payload = encode_pose_matches(static_cast<const PoseMatches&>(*packet.message));
       break;
   }
   const Header& h = packet.header();
@@ -386,6 +452,8 @@ Decoded decode(std::span<const Frame> frames) {
       return {decode_people_3d(header, payload), send_ns};
     case TypeCode::graph_stats:
       return {decode_stats(header, payload), send_ns};
+    case TypeCode::pose_matches:
+      return {decode_pose_matches(header, payload), send_ns};
   }
   throw WireError("unknown message type");
 }

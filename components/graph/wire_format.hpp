@@ -31,6 +31,7 @@ enum class TypeCode : std::uint16_t {
   people_2d = 2,
   people_3d = 3,
   graph_stats = 4,
+  pose_matches = 5,
 };
 
 // Limits checked before any allocation: bytes from a socket are untrusted.
@@ -39,6 +40,7 @@ inline constexpr std::uint32_t kMaxPeople = 4096;
 inline constexpr std::uint32_t kMaxJoints = 256;
 inline constexpr std::uint32_t kMaxImageSide = 32768;
 inline constexpr std::size_t kMaxStatsBytes = 1 << 20;
+inline constexpr std::uint32_t kMaxCandidates = 4096;  // per person
 
 struct Frame {
   const std::byte* data = nullptr;

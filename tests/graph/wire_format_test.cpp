@@ -104,6 +104,33 @@ TEST(WireFormat, People3DRoundTrips) {
   EXPECT_EQ(m.people[1].provenance.clip, "");
 }
 
+TEST(WireFormat, PoseMatchesRoundTrips) {
+  auto original = std::make_shared<PoseMatches>();
+  original->header.stream = "cam0";
+  for (int p = 0; p < 3; ++p) {
+    PersonMatch person;
+    person.id = 10 + p;
+    person.box = {1.0f * p, 2.0f, 3.0f, 4.0f};
+    person.normalized_ok = p != 1;
+    person.body[5] = {5.0f, 6.0f, 0.5f};
+    person.normalized[27] = p == 2 ? std::numeric_limits<float>::quiet_NaN() : 0.25f;
+    for (int c = 0; c < p * 2; ++c) person.candidates.push_back({100u + c, 7u, 3u, 0.5f * c});
+    original->people.push_back(person);
+  }
+  const Packet back = round_trip(Packet::of<PoseMatches>(original));
+  const auto& m = static_cast<const PoseMatches&>(*back.message);
+  ASSERT_EQ(m.people.size(), 3u);
+  EXPECT_EQ(m.people[2].id, 12);
+  EXPECT_FALSE(m.people[1].normalized_ok);
+  EXPECT_EQ(m.people[0].body[5].y, 6.0f);
+  EXPECT_EQ(m.people[1].normalized[27], 0.25f);
+  EXPECT_TRUE(std::isnan(m.people[2].normalized[27]));
+  ASSERT_EQ(m.people[2].candidates.size(), 4u);
+  EXPECT_EQ(m.people[2].candidates[3].projection, 103u);
+  EXPECT_EQ(m.people[2].candidates[3].distance, 1.5f);
+  EXPECT_TRUE(m.people[0].candidates.empty());
+}
+
 TEST(WireFormat, VideoFrameTravelsWithoutCopies) {
   const auto original = video_frame();
   const std::vector<Frame> sent = wire::encode(Packet::of<VideoFrame>(original), 0);
