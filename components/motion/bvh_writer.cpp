@@ -46,24 +46,36 @@ void put_joint(std::ostream& out, const Skeleton& skel, int j, int depth) {
 
 }  // namespace
 
+void write_bvh_hierarchy(const Skeleton& skeleton, std::ostream& out) {
+  out << "HIERARCHY\n";
+  for (int j = 0; j < skeleton.joint_count(); ++j) {
+    if (skeleton.joints[j].parent < 0) put_joint(out, skeleton, j, 0);
+  }
+}
+
+void append_bvh_frame_line(std::span<const float> values, std::string& line) {
+  char buf[32];
+  for (std::size_t c = 0; c < values.size(); ++c) {
+    if (c) line += ' ';
+    const auto [end, ec] = std::to_chars(buf, buf + sizeof buf, values[c]);
+    line.append(buf, end);
+  }
+  line += '\n';
+}
+
 void write_bvh(const Clip& clip, std::ostream& out) {
   const Skeleton& skel = clip.skeleton;
-  out << "HIERARCHY\n";
-  for (int j = 0; j < skel.joint_count(); ++j) {
-    if (skel.joints[j].parent < 0) put_joint(out, skel, j, 0);
-  }
+  write_bvh_hierarchy(skel, out);
   out << "MOTION\nFrames: " << clip.frame_count << "\nFrame Time: ";
   char buf[32];
   const auto [end, ec] = std::to_chars(buf, buf + sizeof buf, clip.frame_time);
   out.write(buf, end - buf);
   out << '\n';
+  std::string line;
   for (int f = 0; f < clip.frame_count; ++f) {
-    const float* row = clip.frame(f);
-    for (int c = 0; c < skel.channel_count; ++c) {
-      if (c) out << ' ';
-      put_number(out, row[c]);
-    }
-    out << '\n';
+    line.clear();
+    append_bvh_frame_line({clip.frame(f), static_cast<std::size_t>(skel.channel_count)}, line);
+    out << line;
   }
 }
 

@@ -71,6 +71,17 @@ TEST(Bvh, EulerConversionReproducesTheMotion) {
   }
 }
 
+// A streaming writer killed between appending a frame line and raising the count leaves one
+// line, whole or cut short, after the declared frames: the frames declared are read.
+TEST(Bvh, OneUnfinishedFrameLineAfterTheDeclaredFramesIsIgnored) {
+  const std::string good = kSmall;
+  for (const char* tail : {"7 7 7 7 7 7 7 7 7\n", "7 7 7 7 7 7 7 7 7", "7 7 -", "  \r\n"}) {
+    const Clip c = parse_bvh(good + tail, "killed.bvh");
+    EXPECT_EQ(c.frame_count, 2) << tail;
+    EXPECT_EQ(c.values, parse_bvh(good, "small.bvh").values) << tail;
+  }
+}
+
 void expect_error(const std::string& text, const std::string& fragment) {
   try {
     parse_bvh(text, "bad.bvh");
@@ -89,7 +100,8 @@ TEST(Bvh, MalformedInputNamesFileAndLine) {
   expect_error("HIERARCHY\nROOT Hips\n{\nOFFSET 0 0 x\n",
                "bad.bvh:4: expected a number for OFFSET z");
   expect_error(good.substr(0, good.size() - 12), "truncated");
-  expect_error(good + "7 7 7\n", "more values");
+  expect_error(good + "7 7 7\n8 8 8\n", "more values");
+  expect_error(good + "1 2 3 4 5 6 7 8 9 10\n", "more values");
   expect_error("HIERARCHY\nROOT Hips\n{\nOFFSET 0 0 0\nCHANNELS 1 Wrotation\n}\nMOTION\n",
                "bad.bvh:5: unknown channel");
   expect_error(
