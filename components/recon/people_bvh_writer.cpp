@@ -1,0 +1,116 @@
+#include "recon/people_bvh_writer.hpp"
+
+#include <cmath>
+#include <exception>
+#include <filesystem>
+#include <stdexcept>
+
+#include "core/input_error.hpp"
+
+namespace mocap::recon {
+
+std::string PeopleBvhSummary::describe() const {
+  return std::to_string(files) + " files, " + std::to_string(frames) + " frames (" +
+         std::to_string(held_over_gaps) + " held over gaps), " + std::to_string(skeleton_mismatch) +
+         " skeleton_mismatch, " + std::to_string(no_provenance) + " without provenance, " +
+         std::to_string(no_skeleton) + " without skeleton";
+}
+
+PeopleBvhWriter::PeopleBvhWriter(const posedb::Database& db, PeopleBvhOptions options)
+    : db_(db), options_(std::move(options)) {
+  if (options_.dir.empty()) throw InputError("dir", "no output folder given");
+  if (!(options_.fps > 0.0) || !std::isfinite(options_.fps))
+    throw std::invalid_argument("PeopleBvhWriter: fps must be positive");
+  if (options_.max_open_files < 1)
+    throw std::invalid_argument("PeopleBvhWriter: max_open_files must be at least 1");
+  std::error_code ec;
+  std::filesystem::create_directories(options_.dir, ec);
+  if (ec) throw InputError(options_.dir, "cannot create the output folder: " + ec.message());
+}
+
+std::string PeopleBvhWriter::path_for(int id) const {
+  return (std::filesystem::path(options_.dir) / (options_.prefix + std::to_string(id) + ".bvh"))
+      .string();
+}
+
+void PeopleBvhWriter::write(const People3D& people) {
+  const std::int64_t frame = people.header.frame;
+  for (const Person3D& person : people.people) {
+    if (person.id < 0) continue;  // not tracked: no identity to give a file
+    const auto track = tracks_.find(person.id);
+    if (track == tracks_.end()) {
+      start(person, frame);
+    } else {
+      append(track->second, person, frame);
+    }
+  }
+}
+
+void PeopleBvhWriter::start(const Person3D& person, std::int64_t frame) {
+  const std::optional<DatabasePose> pose = database_pose_of(db_, person);
+  if (!pose) {
+    ++summary_.no_provenance;
+    return;
+  }
+  const motion::Skeleton& skeleton = source_skeleton(db_, pose->frame);
+  if (skeleton.joints.empty()) {
+    ++summary_.no_skeleton;  // position-only motion; a later pose may come from a real clip
+    return;
+  }
+  keep_open_files_bounded(person.id);
+  BvhFrameMaker maker(skeleton, db_.clips()[db_.frames()[pose->frame].clip].source);
+  std::vector<float> values;
+  maker.channels(db_, *pose, values);
+  motion::BvhStreamWriter file(path_for(person.id), skeleton, 1.0 / options_.fps);
+  file.append(values);
+  tracks_.emplace(person.id, Track{std::move(file), std::move(maker), std::move(values), frame});
+  ++summary_.files;
+  ++summary_.frames;
+}
+
+void PeopleBvhWriter::append(Track& track, const Person3D& person, std::int64_t frame) {
+  if (frame == track.last_frame) return;  // the same id twice in one frame: the first one counts
+  if (track.file.is_suspended()) keep_open_files_bounded(person.id);
+  for (std::int64_t missed = track.last_frame + 1; missed < frame; ++missed) {
+    track.file.append(track.values);
+    ++summary_.held_over_gaps;
+    ++summary_.frames;
+  }
+  // When this pose cannot be written on the file's skeleton, the previous one is held.
+  if (const std::optional<DatabasePose> pose = database_pose_of(db_, person); !pose) {
+    ++summary_.no_provenance;
+  } else if (!same_hierarchy(source_skeleton(db_, pose->frame), track.maker.skeleton())) {
+    ++summary_.skeleton_mismatch;
+  } else {
+    track.maker.channels(db_, *pose, track.values);
+  }
+  track.file.append(track.values);
+  ++summary_.frames;
+  track.last_frame = frame;
+}
+
+// Suspends the open file whose person was seen longest ago when the limit is reached.
+void PeopleBvhWriter::keep_open_files_bounded(int arriving_id) {
+  int open = 0;
+  Track* oldest = nullptr;
+  for (auto& [id, track] : tracks_) {
+    if (!track.file.is_open() || id == arriving_id) continue;
+    ++open;
+    if (!oldest || track.last_frame < oldest->last_frame) oldest = &track;
+  }
+  if (open >= options_.max_open_files && oldest) oldest->file.suspend();
+}
+
+void PeopleBvhWriter::close() {
+  std::exception_ptr first_error;
+  for (auto& [id, track] : tracks_) {
+    try {
+      track.file.close();
+    } catch (...) {
+      if (!first_error) first_error = std::current_exception();
+    }
+  }
+  if (first_error) std::rethrow_exception(first_error);
+}
+
+}  // namespace mocap::recon

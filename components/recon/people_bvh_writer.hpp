@@ -1,0 +1,73 @@
+#pragma once
+// One BVH file per tracked person, written frame by frame as the reconstruction runs (the sink.bvh
+// node): <dir>/<prefix><id>.bvh on the mocap skeleton of the person's first matched clip, valid
+// on disk after every frame (motion::BvhStreamWriter), even if the program is killed.
+//
+// Time stays regular: frame k of a file is input frame (first appearance + k). When a person is
+// missing for some input frames and comes back, their last pose is repeated for the frames
+// missed, so the file stays in step with the video and the JSON lines; a person who never comes
+// back gets no frames after their last appearance (nothing is padded at the end).
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "core/messages.hpp"
+#include "motion/bvh_stream_writer.hpp"
+#include "posedb/database.hpp"
+#include "recon/bvh_frame.hpp"
+
+namespace mocap::recon {
+
+struct PeopleBvhOptions {
+  std::string dir;                 // created when missing
+  std::string prefix = "person_";  // file name before the id
+  double fps = 30.0;               // the input frame rate, written as the frame time
+  int max_open_files = 64;         // more people than this: the longest-unseen file is suspended
+};
+
+struct PeopleBvhSummary {
+  std::int64_t files = 0;
+  std::int64_t frames = 0;             // frame lines written, held ones included
+  std::int64_t held_over_gaps = 0;     // repeated poses for input frames a person was missing in
+  std::int64_t skeleton_mismatch = 0;  // pose from a clip of another skeleton: previous one held
+  std::int64_t no_provenance = 0;      // pose naming no database frame: previous one held or none
+  std::int64_t no_skeleton = 0;        // first pose's clip has no skeleton: file not started yet
+
+  std::string describe() const;  // one line for logs
+};
+
+class PeopleBvhWriter {
+ public:
+  // Creates `options.dir`; throws InputError naming it when that fails. `db` must outlive this.
+  PeopleBvhWriter(const posedb::Database& db, PeopleBvhOptions options);
+
+  // Appends one input frame (header.frame) for every person in it. Throws InputError naming the
+  // file on a write error, or the database when a pose was matched against another one.
+  void write(const People3D& people);
+  // Closes every file (all of them, even when one fails); throws the first error. Idempotent.
+  void close();
+
+  std::string path_for(int id) const;
+  const PeopleBvhSummary& summary() const { return summary_; }
+
+ private:
+  struct Track {
+    motion::BvhStreamWriter file;
+    BvhFrameMaker maker;
+    std::vector<float> values;  // the last pose written
+    std::int64_t last_frame = 0;
+  };
+
+  void start(const Person3D& person, std::int64_t frame);
+  void append(Track& track, const Person3D& person, std::int64_t frame);
+  void keep_open_files_bounded(int arriving_id);
+
+  const posedb::Database& db_;
+  PeopleBvhOptions options_;
+  std::map<int, Track> tracks_;
+  PeopleBvhSummary summary_;
+};
+
+}  // namespace mocap::recon
