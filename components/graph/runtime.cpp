@@ -262,7 +262,11 @@ void NodeRunner::send_packet(std::string_view port, Packet packet) {
     throw std::logic_error("node '" + node_.name + "': output '" + std::string(port) +
                            "' carries " + out.type + ", not " + std::string(packet.type));
   }
+  // Waiting for room in a full downstream queue is back-pressure, not this node's work: it is
+  // left out of the processing time, as sleeping is.
+  const auto push_start = Clock::now();
   for (auto& [inbox, input] : out.local) inbox->push(input, packet);
+  slept_ += Clock::now() - push_start;
   for (RemoteOutput& remote : out.remote) {
     const auto give_up = [&] { return remote.lossy || runtime_.drain_expired(); };
     if (!remote.sender->send(packet, give_up)) ++own_drops_;

@@ -42,25 +42,31 @@ float partial_height(const float* row, const posedb::PoseVector& weights) {
 
 }  // namespace
 
-// A partial body normalised by its own box is too large (the box of the visible joints is
-// smaller than the whole body's). After a first search the best candidate tells how tall that
-// partial box is in database units; the query is rescaled to it and searched again.
-bool Matcher::match(std::span<const float, kBodyJoints * 3> body, std::vector<Candidate>& out) {
-  out.clear();
+bool normalize_body(std::span<const float, kBodyJoints * 3> body, posedb::Scaling scaling,
+                    const ScalerOptions& options, posedb::PoseVector& out) {
   std::array<glm::vec2, kBodyJoints> points;
   int present = 0;
   constexpr float nan = std::numeric_limits<float>::quiet_NaN();
   for (int j = 0; j < kBodyJoints; ++j) {
-    const bool ok = body[3 * j + 2] >= options_.min_confidence && std::isfinite(body[3 * j]) &&
+    const bool ok = body[3 * j + 2] >= options.min_confidence && std::isfinite(body[3 * j]) &&
                     std::isfinite(body[3 * j + 1]);
     points[j] = ok ? glm::vec2(body[3 * j], body[3 * j + 1]) : glm::vec2(nan, nan);
     present += ok ? 1 : 0;
   }
-  if (present < options_.min_joints) return false;
-  posedb::PoseVector query, weights;
-  if (!posedb::normalize_pose(points, db_.build_info().scaling, query)) return false;
-  for (int d = 0; d < posedb::kPoseDims; ++d) weights[d] = std::isfinite(query[d]) ? 1.0f : 0.0f;
+  return present >= options.min_joints && posedb::normalize_pose(points, scaling, out);
+}
 
+// A partial body normalised by its own box is too large (the box of the visible joints is
+// smaller than the whole body's). After a first search the best candidate tells how tall that
+// partial box is in database units; the query is rescaled to it and searched again.
+void Matcher::search(const posedb::PoseVector& normalized, std::vector<Candidate>& out) {
+  out.clear();
+  posedb::PoseVector query = normalized, weights;
+  int present = 1;  // the root
+  for (int d = 0; d < posedb::kPoseDims; ++d) {
+    weights[d] = std::isfinite(query[d]) ? 1.0f : 0.0f;
+    present += d % 2 == 0 && weights[d] > 0.0f ? 1 : 0;
+  }
   auto& found = search_->neighbors;
   const bool partial =
       present < kBodyJoints && db_.build_info().scaling == posedb::Scaling::bbox_height;
@@ -77,6 +83,15 @@ bool Matcher::match(std::span<const float, kBodyJoints * 3> body, std::vector<Ca
   for (const auto& n : found) {
     out.push_back({n.index, records[n.index].frame, records[n.index].view, n.distance});
   }
+}
+
+bool Matcher::match(std::span<const float, kBodyJoints * 3> body, std::vector<Candidate>& out) {
+  posedb::PoseVector query;
+  if (!normalize_body(body, db_.build_info().scaling, options_.scaler, query)) {
+    out.clear();
+    return false;
+  }
+  search(query, out);
   return !out.empty();
 }
 

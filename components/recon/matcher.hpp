@@ -10,25 +10,32 @@
 #include <vector>
 
 #include "core/body15.hpp"
+#include "core/messages.hpp"
 #include "posedb/database.hpp"
 
 namespace mocap::recon {
 
-struct MatchOptions {
-  int k = 32;          // candidates per person
-  int probe = 16;      // clusters scanned (see the search benchmark in the issue-2 report)
-  bool exact = false;  // scan every projection instead (slow; for evaluation)
+struct ScalerOptions {
   float min_confidence = 0.05f;  // joints below are treated as missing
   int min_joints = 6;            // fewer present joints: no match
-  int rescale_passes = 2;        // for partial bodies, see Matcher::match
 };
 
-struct Candidate {
-  std::uint32_t projection = 0;  // row in the database's projections
-  std::uint32_t frame = 0;       // database frame
-  std::uint32_t view = 0;
-  float distance = 0.0f;  // weighted squared distance over the present joints
+// The scaler: the database's normalisation applied to a person's 15 body joints (x, y,
+// confidence in image pixels). Missing joints come out as NaN. False when the pose cannot be
+// normalised (root missing, too few joints).
+bool normalize_body(std::span<const float, kBodyJoints * 3> body_xyc, posedb::Scaling scaling,
+                    const ScalerOptions& options, posedb::PoseVector& out);
+
+struct MatchOptions {
+  int k = 32;              // candidates per person
+  int probe = 16;          // clusters scanned (see the search benchmark in the issue-2 report)
+  bool exact = false;      // scan every projection instead (slow; for evaluation)
+  int rescale_passes = 2;  // for partial bodies, see Matcher::search
+  ScalerOptions scaler;
 };
+
+// A database projection near a query: projection row, database frame and view, distance.
+using Candidate = PoseCandidate;
 
 class Matcher {
  public:
@@ -36,8 +43,11 @@ class Matcher {
   ~Matcher();
   Matcher(Matcher&&) noexcept;
 
-  // `body_xyc`: 15 joints (x, y, confidence) in image coordinates, y down. Returns false when the
-  // pose cannot be matched (root missing, too few joints). `out` is reused between calls.
+  // The k nearest projections of a normalised pose (NaN = missing joint, left out of the
+  // distance). `out` is reused between calls.
+  void search(const posedb::PoseVector& query, std::vector<Candidate>& out);
+  // Scaler and search in one: `body_xyc` is 15 joints (x, y, confidence) in image pixels, y down.
+  // Returns false when the pose cannot be normalised.
   bool match(std::span<const float, kBodyJoints * 3> body_xyc, std::vector<Candidate>& out);
 
   const MatchOptions& options() const { return options_; }

@@ -76,89 +76,94 @@ float transition(const FrameBones& bones, std::uint32_t a, std::uint32_t b, cons
   return bone_distance(bones[from], bones[a]) + o.clip_jump_penalty;
 }
 
-// Viterbi over `frames`; when `anchor` is given the path starts after it.
-std::vector<std::size_t> viterbi(const std::vector<const std::vector<Candidate>*>& frames,
-                                 const FrameBones& bones, const PathOptions& o,
-                                 const Candidate* anchor) {
-  const std::size_t n = frames.size();
-  std::vector<std::size_t> path(n, 0);
-  if (n == 0) return path;
-  std::vector<std::vector<float>> cost(n);
-  std::vector<std::vector<std::uint32_t>> back(n);
-  for (std::size_t t = 0; t < n; ++t) {
-    const auto& cands = *frames[t];
-    cost[t].assign(cands.size(), 0.0f);
-    back[t].assign(cands.size(), 0);
-    for (std::size_t b = 0; b < cands.size(); ++b) {
-      float best = 0.0f;
-      if (t == 0) {
-        best = anchor ? transition(bones, anchor->frame, cands[b].frame, o) : 0.0f;
-      } else {
-        best = std::numeric_limits<float>::max();
-        const auto& prev = *frames[t - 1];
-        for (std::size_t a = 0; a < prev.size(); ++a) {
-          const float c = cost[t - 1][a] + transition(bones, prev[a].frame, cands[b].frame, o);
-          if (c < best) best = c, back[t][b] = static_cast<std::uint32_t>(a);
-        }
-        if (prev.empty()) best = 0.0f;
-      }
-      cost[t][b] = best + o.data_weight * cands[b].distance;
-    }
-  }
-  // Frames without candidates break the chain: each stretch is traced back on its own.
-  std::size_t t = n;
-  while (t-- > 0) {
-    if (frames[t]->empty()) continue;
-    const bool chain_end = t + 1 == n || frames[t + 1]->empty();
-    if (chain_end) {
-      path[t] = static_cast<std::size_t>(std::min_element(cost[t].begin(), cost[t].end()) -
-                                         cost[t].begin());
-    } else {
-      path[t] = back[t + 1][path[t + 1]];
-    }
-  }
-  return path;
-}
-
 }  // namespace
 
 std::vector<std::size_t> best_path(std::span<const std::vector<Candidate>> candidates,
                                    const FrameBones& bones, const PathOptions& options) {
-  std::vector<const std::vector<Candidate>*> frames;
-  for (const auto& c : candidates) frames.push_back(&c);
-  return viterbi(frames, bones, options, nullptr);
+  LaggedPathSelector selector(bones, options, std::numeric_limits<int>::max());
+  std::vector<LaggedPathSelector::Decision> decisions;
+  for (const auto& c : candidates) {
+    auto d = selector.push(c);
+    decisions.insert(decisions.end(), d.begin(), d.end());
+  }
+  auto d = selector.flush();
+  decisions.insert(decisions.end(), d.begin(), d.end());
+  std::vector<std::size_t> path(candidates.size(), 0);
+  for (const auto& [frame, choice] : decisions) {
+    if (!choice) continue;
+    const auto& c = candidates[frame];
+    path[frame] = static_cast<std::size_t>(
+        std::find_if(c.begin(), c.end(),
+                     [&](const Candidate& x) { return x.projection == choice->projection; }) -
+        c.begin());
+  }
+  return path;
 }
 
 LaggedPathSelector::LaggedPathSelector(const FrameBones& bones, const PathOptions& options, int lag)
-    : bones_(bones), options_(options), lag_(std::max(0, lag)) {}
+    : bones_(bones), options_(options), lag_(static_cast<std::size_t>(std::max(0, lag))) {}
+
+// Costs of the newest step from the one before it (or from nothing at the start of a path).
+void LaggedPathSelector::extend(Step& step) const {
+  const std::size_t n = step.candidates.size();
+  step.cost.assign(n, 0.0f);
+  step.back.assign(n, 0);
+  const Step* prev = pending_.empty() ? nullptr : &pending_.back();
+  for (std::size_t b = 0; b < n; ++b) {
+    float best = 0.0f;
+    if (prev) {
+      best = std::numeric_limits<float>::max();
+      for (std::size_t a = 0; a < prev->candidates.size(); ++a) {
+        const float c = prev->cost[a] + transition(bones_, prev->candidates[a].frame,
+                                                   step.candidates[b].frame, options_);
+        if (c < best) best = c, step.back[b] = static_cast<std::uint32_t>(a);
+      }
+    }
+    step.cost[b] = best + options_.data_weight * step.candidates[b].distance;
+  }
+}
+
+// Follows the best path back from the newest step to the oldest and decides the oldest.
+void LaggedPathSelector::decide_oldest(std::vector<Decision>& out) {
+  const Step& last = pending_.back();
+  std::size_t index = static_cast<std::size_t>(
+      std::min_element(last.cost.begin(), last.cost.end()) - last.cost.begin());
+  for (std::size_t s = pending_.size() - 1; s > 0; --s) index = pending_[s].back[index];
+  out.emplace_back(next_frame_++, pending_.front().candidates[index]);
+  pending_.pop_front();
+}
+
+void LaggedPathSelector::decide_all(std::vector<Decision>& out) {
+  if (pending_.empty()) return;
+  const Step& last = pending_.back();
+  std::vector<std::size_t> path(pending_.size());
+  path.back() = static_cast<std::size_t>(std::min_element(last.cost.begin(), last.cost.end()) -
+                                         last.cost.begin());
+  for (std::size_t s = pending_.size() - 1; s > 0; --s) path[s - 1] = pending_[s].back[path[s]];
+  for (std::size_t s = 0; s < pending_.size(); ++s)
+    out.emplace_back(next_frame_++, pending_[s].candidates[path[s]]);
+  pending_.clear();
+}
 
 std::vector<LaggedPathSelector::Decision> LaggedPathSelector::push(
     std::vector<Candidate> candidates) {
-  pending_.push_back(std::move(candidates));
-  return decide(false);
+  std::vector<Decision> decided;
+  if (candidates.empty()) {
+    decide_all(decided);  // the path ends here
+    decided.emplace_back(next_frame_++, std::nullopt);
+    return decided;
+  }
+  Step step;
+  step.candidates = std::move(candidates);
+  extend(step);
+  pending_.push_back(std::move(step));
+  while (pending_.size() > lag_) decide_oldest(decided);
+  return decided;
 }
 
-std::vector<LaggedPathSelector::Decision> LaggedPathSelector::flush() { return decide(true); }
-
-std::vector<LaggedPathSelector::Decision> LaggedPathSelector::decide(bool all) {
+std::vector<LaggedPathSelector::Decision> LaggedPathSelector::flush() {
   std::vector<Decision> decided;
-  while (!pending_.empty() && (all || pending_.size() > static_cast<std::size_t>(lag_))) {
-    std::vector<const std::vector<Candidate>*> frames;
-    for (const auto& p : pending_) frames.push_back(&p);
-    const auto path = viterbi(frames, bones_, options_, has_anchor_ ? &anchor_ : nullptr);
-    const auto& first = pending_.front();
-    if (first.empty()) {
-      has_anchor_ = false;  // a gap: the next stretch starts afresh
-      decided.emplace_back(first_pending_, std::nullopt);
-    } else {
-      anchor_ = first[path[0]];
-      has_anchor_ = true;
-      decided.emplace_back(first_pending_, anchor_);
-    }
-    pending_.pop_front();
-    ++first_pending_;
-    if (!all) break;
-  }
+  decide_all(decided);
   return decided;
 }
 

@@ -59,30 +59,38 @@ struct PathOptions {
 };
 
 // Viterbi over all candidates of a sequence: the path minimising Σ data + continuity, where the
-// continuity of b after a compares b's previous mocap frame with a. Returns one index per frame.
+// continuity of b after a compares b's previous mocap frame with a. Returns one index per frame
+// (0 for frames without candidates).
 std::vector<std::size_t> best_path(std::span<const std::vector<Candidate>> candidates,
                                    const FrameBones& bones, const PathOptions& options);
 
-// The same with a fixed lag for live use: frame t is decided once frame t + lag has arrived.
+// The same, incrementally, with a fixed lag for live use: frame t is decided once frame t + lag
+// has arrived, from the best path through everything seen so far (O(K²) work per frame). A frame
+// without candidates ends the path: the frames before it are decided at once.
 class LaggedPathSelector {
  public:
   LaggedPathSelector(const FrameBones& bones, const PathOptions& options, int lag);
   // (frame index, choice); no choice for a frame that had no candidates.
   using Decision = std::pair<std::size_t, std::optional<Candidate>>;
-  // Adds a frame's candidates; returns the decisions that became final.
+  // Adds a frame's candidates; returns the decisions that became final, in frame order.
   std::vector<Decision> push(std::vector<Candidate> candidates);
   // Decides the frames still pending (end of stream).
   std::vector<Decision> flush();
 
  private:
-  std::vector<Decision> decide(bool all);
+  struct Step {
+    std::vector<Candidate> candidates;
+    std::vector<float> cost;          // best path cost ending at each candidate
+    std::vector<std::uint32_t> back;  // its predecessor in the previous step
+  };
+  void extend(Step& step) const;
+  void decide_oldest(std::vector<Decision>& out);
+  void decide_all(std::vector<Decision>& out);
   const FrameBones& bones_;
   PathOptions options_;
-  int lag_;
-  std::size_t first_pending_ = 0;
-  std::deque<std::vector<Candidate>> pending_;
-  bool has_anchor_ = false;
-  Candidate anchor_;  // the last decided choice: the path continues from it
+  std::size_t lag_;
+  std::size_t next_frame_ = 0;  // index of the oldest pending step
+  std::deque<Step> pending_;
 };
 
 }  // namespace mocap::recon

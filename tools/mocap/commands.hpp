@@ -8,5 +8,8 @@ int db_command(int argc, char** argv);
 int run_command(int argc, char** argv);
 int graph_command(int argc, char** argv);
 int eval_command(int argc, char** argv);
+// `mocap eval humaneva`, reached through eval_command.
+int humaneva_eval_command(int argc, char** argv);
+int reconstruct_command(int argc, char** argv);
 
 }  // namespace mocap::cli

@@ -15,9 +15,13 @@ struct Command {
 };
 
 constexpr Command kCommands[] = {
+    {"reconstruct", "3D motion of every person from a folder of OpenPose JSON",
+     mocap::cli::reconstruct_command},
     {"db", "build, inspect and query the 2D-projection pose database", mocap::cli::db_command},
-    {"run", "run a graph file (nodes wired by YAML), in one or several processes", mocap::cli::run_command},
-    {"graph", "validate a graph file, inspect node types, export Graphviz", mocap::cli::graph_command},
+    {"run", "run a graph file (nodes wired by YAML), in one or several processes",
+     mocap::cli::run_command},
+    {"graph", "validate a graph file, inspect node types, export Graphviz",
+     mocap::cli::graph_command},
     {"eval", "measure accuracy: virtual-video and HumanEva-I protocols", mocap::cli::eval_command},
 };
 
@@ -26,7 +30,7 @@ void print_usage(std::ostream& out) {
          "Markerless motion capture: video or 2D keypoints in, 3D motion of every person out.\n\n"
          "commands:\n";
   for (const auto& c : kCommands) {
-    out << "  " << c.name << std::string(12 - c.name.size(), ' ') << c.summary << "\n";
+    out << "  " << c.name << std::string(14 - c.name.size(), ' ') << c.summary << "\n";
   }
   out << "\nRun 'mocap COMMAND --help' for the options of a command.\n";
 }

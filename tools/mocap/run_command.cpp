@@ -14,6 +14,7 @@
 #include "graph/runtime.hpp"
 #include "graph/signals.hpp"
 #include "graph/supervisor.hpp"
+#include "graph_runner.hpp"
 
 namespace mocap::cli {
 namespace {
@@ -27,46 +28,14 @@ std::string this_program() {
   return std::string(path, static_cast<std::size_t>(size));
 }
 
-// Signals may arrive before the runtime exists; the request is kept until it does.
-class StopRelay {
- public:
-  void attach(Runtime* runtime) {
-    std::lock_guard lock(mutex_);
-    runtime_ = runtime;
-    if (runtime_ && requested_) runtime_->request_stop();
-  }
-  void request() {
-    std::lock_guard lock(mutex_);
-    requested_ = true;
-    if (runtime_) runtime_->request_stop();
-  }
-
- private:
-  std::mutex mutex_;
-  Runtime* runtime_ = nullptr;
-  bool requested_ = false;
-};
-
 int run_here(const ResolvedGraph& graph, const Args& args) {
-  StopRelay relay;
   const std::string label =
       args.has("process") ? "mocap run [" + args.get("process") + "]" : "mocap run";
-  SignalWatcher watcher([&](int, int count) {
-    if (count > 1) {
-      std::cerr << label << ": second stop signal, exiting without draining\n";
-      std::_Exit(130);
-    }
-    std::cerr << label << ": stopping: draining the graph (signal again to exit at once)\n";
-    relay.request();
-  });
   RunOptions options;
   options.process = args.get("process");
   options.single_process = args.has("single-process");
   options.drain_timeout = std::chrono::milliseconds(args.integer("drain-timeout"));
-  Runtime runtime(graph, options);
-  relay.attach(&runtime);
-  const RunResult result = runtime.run();
-  relay.attach(nullptr);
+  const RunResult result = run_graph_here(graph, options, label);
   if (!args.has("quiet")) std::cerr << format_stats_table(result.stats);
   if (!result.ok) {
     std::cerr << label << ": " << result.error << "\n";

@@ -1,0 +1,64 @@
+// sink.jsonl: one JSON line per input frame, in input order:
+//   {"frame": 0, "time": 0.0, "people": [{"id": 1, "joints": {"head": [x, y, z], ...}}]}
+// with the 15 body joint names, metres, camera coordinates (x right, y down, z forward),
+// root-relative while no translation is estimated. Each line is flushed as it is written, so the
+// file holds every finished frame even if the run is killed.
+
+#include <cstdio>
+#include <memory>
+
+#include <nlohmann/json.hpp>
+
+#include "core/input_error.hpp"
+#include "graph/registry.hpp"
+
+namespace mocap::nodes {
+using namespace mocap::graph;
+
+class JsonLinesSink : public Node {
+ public:
+  static void contract(Contract& c) {
+    c.doc("Writes one JSON line per frame with every person's 15 joints");
+    c.input<People3D>("in");
+    c.required_param<std::string>("path", "file to write (poses.jsonl)");
+  }
+  void open(Context& ctx) override {
+    path_ = ctx.param<std::string>("path");
+    file_.reset(std::fopen(path_.c_str(), "w"));
+    if (!file_) throw InputError(path_, "cannot create the file");
+  }
+  void process(Context& ctx) override {
+    const auto& in = ctx.input<People3D>("in");
+    nlohmann::ordered_json people = nlohmann::ordered_json::array();
+    for (const Person3D& p : in.people) {
+      nlohmann::ordered_json joints = nlohmann::ordered_json::object();
+      for (int j = 0; j < kBodyJoints; ++j) {
+        joints[std::string(kJointNames[j])] = {
+            round_mm(p.positions[j].x), round_mm(p.positions[j].y), round_mm(p.positions[j].z)};
+      }
+      people.push_back({{"id", p.id}, {"joints", joints}});
+    }
+    const nlohmann::ordered_json line = {{"frame", in.header.frame},
+                                         {"time", static_cast<double>(in.header.capture_ns) * 1e-9},
+                                         {"people", people}};
+    const std::string text = line.dump() + "\n";
+    if (std::fwrite(text.data(), 1, text.size(), file_.get()) != text.size() ||
+        std::fflush(file_.get()) != 0) {
+      throw InputError(path_, "write failed (disk full?)");
+    }
+  }
+  void close(Context&) override { file_.reset(); }
+
+ private:
+  // Millimetre precision keeps the file small and the numbers readable.
+  static double round_mm(float v) { return std::round(static_cast<double>(v) * 1000.0) / 1000.0; }
+  struct Closer {
+    void operator()(std::FILE* f) const { std::fclose(f); }
+  };
+  std::string path_;
+  std::unique_ptr<std::FILE, Closer> file_;
+};
+
+MOCAP_REGISTER_NODE("sink.jsonl", JsonLinesSink)
+
+}  // namespace mocap::nodes

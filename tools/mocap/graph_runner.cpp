@@ -1,0 +1,52 @@
+#include "graph_runner.hpp"
+
+#include <cstdlib>
+#include <iostream>
+#include <mutex>
+
+#include "graph/signals.hpp"
+
+namespace mocap::cli {
+namespace {
+
+// Signals may arrive before the runtime exists; the request is kept until it does.
+class StopRelay {
+ public:
+  void attach(graph::Runtime* runtime) {
+    std::lock_guard lock(mutex_);
+    runtime_ = runtime;
+    if (runtime_ && requested_) runtime_->request_stop();
+  }
+  void request() {
+    std::lock_guard lock(mutex_);
+    requested_ = true;
+    if (runtime_) runtime_->request_stop();
+  }
+
+ private:
+  std::mutex mutex_;
+  graph::Runtime* runtime_ = nullptr;
+  bool requested_ = false;
+};
+
+}  // namespace
+
+graph::RunResult run_graph_here(const graph::ResolvedGraph& graph, graph::RunOptions options,
+                                const std::string& label) {
+  StopRelay relay;
+  graph::SignalWatcher watcher([&](int, int count) {
+    if (count > 1) {
+      std::cerr << label << ": second stop signal, exiting without draining\n";
+      std::_Exit(130);
+    }
+    std::cerr << label << ": stopping: draining the graph (signal again to exit at once)\n";
+    relay.request();
+  });
+  graph::Runtime runtime(graph, std::move(options));
+  relay.attach(&runtime);
+  graph::RunResult result = runtime.run();
+  relay.attach(nullptr);
+  return result;
+}
+
+}  // namespace mocap::cli
