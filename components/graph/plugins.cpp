@@ -25,10 +25,28 @@ std::string last_dl_error() {
 
 }  // namespace
 
+namespace {
+
+using AbiFunction = const char* (*)();
+
+AbiFunction plugin_abi(void* handle, const std::string& path) {
+  const auto abi = reinterpret_cast<AbiFunction>(dlsym(handle, "mocap_plugin_abi"));
+  if (!abi) {
+    throw std::runtime_error("plugin " + path + ": not a mocap plugin (no MOCAP_PLUGIN())");
+  }
+  return abi;
+}
+
+}  // namespace
+
 void load_plugin(const std::string& path) {
   const std::string canonical = std::filesystem::weakly_canonical(path).string();
-  // Already loaded: RTLD_NOLOAD only succeeds for a library in the process.
-  if (LibraryHandle loaded{dlopen(canonical.c_str(), RTLD_NOW | RTLD_NOLOAD)}) return;
+  // Already loaded (RTLD_NOLOAD only succeeds for a library in the process): its node types are
+  // registered, if it is a plugin at all; a library loaded for another reason is still refused.
+  if (LibraryHandle loaded{dlopen(canonical.c_str(), RTLD_NOW | RTLD_NOLOAD)}) {
+    plugin_abi(loaded.get(), path);
+    return;
+  }
 
   // Registration runs in the library's static initialisers, inside dlopen.
   Registry::instance().set_origin(canonical);
@@ -36,11 +54,7 @@ void load_plugin(const std::string& path) {
   Registry::instance().set_origin("built-in");
   if (!handle) throw std::runtime_error("plugin " + path + ": " + last_dl_error());
 
-  using AbiFunction = const char* (*)();
-  const auto abi = reinterpret_cast<AbiFunction>(dlsym(handle.get(), "mocap_plugin_abi"));
-  if (!abi) {
-    throw std::runtime_error("plugin " + path + ": not a mocap plugin (no MOCAP_PLUGIN())");
-  }
+  const AbiFunction abi = plugin_abi(handle.get(), path);
   if (std::strcmp(abi(), kPluginAbi) != 0) {
     throw std::runtime_error("plugin " + path + ": built for " + abi() + ", this program is " +
                              kPluginAbi);
