@@ -1,5 +1,6 @@
 #include "motion/pose_sequence.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -160,25 +161,35 @@ PoseSequence slice(const PoseSequence& poses, int first, int count) {
   return out;
 }
 
-PoseSequence resample(const PoseSequence& poses, double fps) {
-  if (!(fps > 0.0) || !(poses.fps > 0.0))
+std::vector<ResampleStep> resample_steps(int frame_count, double from_fps, double to_fps) {
+  if (!(from_fps > 0.0) || !(to_fps > 0.0))
     throw std::invalid_argument("resample: frame rates must be positive");
+  std::vector<ResampleStep> steps;
+  if (frame_count <= 0) return steps;
+  const double step = from_fps / to_fps;  // input frames per output frame
+  // A tiny tolerance so that 120 -> 24 fps lands exactly on every 5th frame.
+  const int count = static_cast<int>(std::floor((frame_count - 1) / step + 1e-9)) + 1;
+  steps.reserve(static_cast<std::size_t>(count));
+  for (int k = 0; k < count; ++k) {
+    const double s = k * step;
+    const int a = std::min(static_cast<int>(std::floor(s + 1e-9)), frame_count - 1);
+    const int b = std::min(a + 1, frame_count - 1);
+    steps.push_back({a, b, static_cast<float>(std::max(0.0, s - a))});
+  }
+  return steps;
+}
+
+PoseSequence resample(const PoseSequence& poses, double fps) {
+  const std::vector<ResampleStep> steps = resample_steps(poses.frame_count, poses.fps, fps);
   PoseSequence out;
   out.skeleton = poses.skeleton;
   out.fps = fps;
-  if (poses.frame_count == 0) return out;
-  const double step = poses.fps / fps;  // input frames per output frame
-  // A tiny tolerance so that 120 -> 24 fps lands exactly on every 5th frame.
-  out.frame_count = static_cast<int>(std::floor((poses.frame_count - 1) / step + 1e-9)) + 1;
+  out.frame_count = static_cast<int>(steps.size());
   const int joints = poses.joint_count();
   out.translation.resize(static_cast<size_t>(out.frame_count) * joints);
   out.rotation.resize(static_cast<size_t>(out.frame_count) * joints);
   for (int k = 0; k < out.frame_count; ++k) {
-    const double s = k * step;
-    int a = static_cast<int>(std::floor(s + 1e-9));
-    if (a > poses.frame_count - 1) a = poses.frame_count - 1;
-    const int b = std::min(a + 1, poses.frame_count - 1);
-    const float w = static_cast<float>(std::max(0.0, s - a));
+    const auto [a, b, w] = steps[static_cast<std::size_t>(k)];
     for (int j = 0; j < joints; ++j) {
       const glm::quat qa = poses.rotation[poses.at(a, j)];
       glm::quat qb = poses.rotation[poses.at(b, j)];

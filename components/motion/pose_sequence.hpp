@@ -2,8 +2,11 @@
 // Motion as local joint transforms (translation + quaternion per joint per frame): the form that
 // forward kinematics, resampling and the pose database work with.
 
+#include <array>
+#include <span>
 #include <vector>
 
+#include <glm/common.hpp>
 #include <glm/gtc/quaternion.hpp>
 #include <glm/vec3.hpp>
 
@@ -41,6 +44,30 @@ PoseSequence slice(const PoseSequence& poses, int first, int count);
 // translations interpolated linearly. Keeps the first frame; the last output frame is the last
 // one at or before the end of the input.
 PoseSequence resample(const PoseSequence& poses, double fps);
+
+// Where output frame k of a resampling lies in the input: `weight` of the way from input frame
+// `before` to `after`. The one rule of every resampling in the project (`resample` above).
+struct ResampleStep {
+  int before = 0;
+  int after = 0;
+  float weight = 0.0f;
+};
+std::vector<ResampleStep> resample_steps(int frame_count, double from_fps, double to_fps);
+
+// Resamples frames of points (joint positions, 2D keypoints) by linear interpolation, with the
+// same frame times as `resample`.
+template <typename Point, std::size_t N>
+std::vector<std::array<Point, N>> resample_points(std::span<const std::array<Point, N>> frames,
+                                                  double from_fps, double to_fps) {
+  std::vector<std::array<Point, N>> out;
+  for (const ResampleStep& step :
+       resample_steps(static_cast<int>(frames.size()), from_fps, to_fps)) {
+    std::array<Point, N>& frame = out.emplace_back();
+    for (std::size_t j = 0; j < N; ++j)
+      frame[j] = glm::mix(frames[step.before][j], frames[step.after][j], step.weight);
+  }
+  return out;
+}
 
 // Global transforms of every joint (End Sites included) in one frame.
 struct GlobalPose {

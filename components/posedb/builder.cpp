@@ -16,6 +16,7 @@
 #include "motion/asf_amc.hpp"
 #include "motion/body_mapping.hpp"
 #include "motion/bvh.hpp"
+#include "motion/pose_sequence.hpp"
 #include "posedb/kmeans.hpp"
 #include "posedb/projection.hpp"
 
@@ -100,24 +101,29 @@ std::vector<std::pair<int, int>> capture_runs(const motion::Clip& clip, bool ski
   return runs;
 }
 
+// Turns one frame's world body about the vertical to face +Z around its root and appends it,
+// with the root and the heading removed. `heading` carries the last measured facing over frames
+// where it cannot be measured (hips and shoulders seen end-on).
+void add_body_frame(std::array<glm::vec3, kBodyJoints> body, float& heading, ClipFrames& out) {
+  facing(body, heading);
+  const glm::vec3 root = body[index(Joint::root)];
+  const glm::quat turn = glm::angleAxis(-heading, glm::vec3(0, 1, 0));
+  for (auto& p : body) p = turn * (p - root);
+  out.joints.push_back(body);
+  out.frames.push_back(
+      {0, static_cast<std::uint32_t>(out.frames.size()), heading, {root.x, root.y, root.z}});
+}
+
 void add_run(const motion::PoseSequence& poses, const motion::BodyMapping& mapping,
              ClipFrames& out) {
   motion::GlobalPose global;
-  float last_heading = 0.0f;
+  float heading = 0.0f;
   const int joints = poses.joint_count();
   for (int f = 0; f < poses.frame_count; ++f) {
     motion::forward_kinematics(poses, f, global);
     std::array<glm::vec3, kBodyJoints> body;
     motion::body_positions(mapping, global, body);
-    float heading = last_heading;
-    facing(body, heading);
-    last_heading = heading;
-    const glm::vec3 root = body[index(Joint::root)];
-    const glm::quat turn = glm::angleAxis(-heading, glm::vec3(0, 1, 0));
-    for (auto& p : body) p = turn * (p - root);
-    out.joints.push_back(body);
-    out.frames.push_back(
-        {0, static_cast<std::uint32_t>(out.frames.size()), heading, {root.x, root.y, root.z}});
+    add_body_frame(body, heading, out);
     for (int j = 0; j < joints; ++j) {
       const glm::quat q = poses.rotation[poses.at(f, j)];
       out.rotations.insert(out.rotations.end(), {q.w, q.x, q.y, q.z});
@@ -181,6 +187,55 @@ std::vector<ClipFrames> read_all(const std::vector<std::string>& files, const Bu
     for (auto& c : f) clips.push_back(std::move(c));
   }
   report.files_read = files.size() - report.skipped.size();
+  std::sort(report.skipped.begin(), report.skipped.end());
+  return clips;
+}
+
+// Why a position-only sequence cannot be used, or empty when it can.
+std::string unusable(const BodySequence& sequence) {
+  if (sequence.frames.empty()) return "no frames";
+  if (!(sequence.fps > 0.0 && sequence.fps <= 1000.0)) return "frame rate not in (0, 1000]";
+  for (std::size_t f = 0; f < sequence.frames.size(); ++f) {
+    for (const glm::vec3& p : sequence.frames[f]) {
+      if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+        return "non-finite joint position in frame " + std::to_string(f);
+    }
+  }
+  return {};
+}
+
+// A position-only sequence as a clip without skeleton or rotations.
+ClipFrames clip_from_bodies(const BodySequence& sequence, const BuildOptions& options) {
+  ClipFrames c;
+  c.info.name = sequence.name;
+  c.info.source = sequence.source;
+  c.info.family = sequence.family;
+  c.info.mapping = sequence.mapping;
+  c.info.source_fps = sequence.fps;
+  float heading = 0.0f;
+  for (const auto& body :
+       motion::resample_points(std::span<const std::array<glm::vec3, kBodyJoints>>(sequence.frames),
+                               sequence.fps, options.fps)) {
+    add_body_frame(body, heading, c);
+  }
+  c.info.frame_count = static_cast<std::uint32_t>(c.frames.size());
+  return c;
+}
+
+std::vector<ClipFrames> clips_from_bodies(const std::vector<BodySequence>& sequences,
+                                          const BuildOptions& options,
+                                          const BuildProgress& progress, BuildReport& report) {
+  std::vector<ClipFrames> clips;
+  for (std::size_t i = 0; i < sequences.size(); ++i) {
+    if (const std::string why = unusable(sequences[i]); !why.empty()) {
+      report.skipped.push_back(sequences[i].name + ": " + why);
+    } else {
+      clips.push_back(clip_from_bodies(sequences[i], options));
+    }
+    if (progress)
+      progress("read", static_cast<double>(i + 1) / static_cast<double>(sequences.size()));
+  }
+  report.files_read = clips.size();
   std::sort(report.skipped.begin(), report.skipped.end());
   return clips;
 }
@@ -270,6 +325,41 @@ std::string now_iso() {
   return buf;
 }
 
+void check_fps(const BuildOptions& options) {
+  if (!(options.fps > 0.0 && options.fps <= 1000.0))
+    throw InputError("--fps", "must be between 0 and 1000");
+}
+
+// The steps after reading, shared by every kind of input: gather the clips, project every frame
+// through every view, cluster, record the options. `inputs` names what was read, for the error.
+DatabaseContents assemble(std::vector<ClipFrames>& clips, const BuildOptions& options,
+                          const BuildProgress& progress, BuildReport& report,
+                          const std::string& inputs,
+                          std::chrono::steady_clock::time_point started) {
+  DatabaseContents db;
+  db.views = make_views(options.views);
+  std::vector<std::array<glm::vec3, kBodyJoints>> joints;
+  gather(clips, db, joints);
+  if (db.frames.empty()) {
+    throw InputError("",
+                     "no usable motion in " + inputs +
+                         (report.skipped.empty() ? std::string()
+                                                 : "; first problem: " + report.skipped.front()));
+  }
+  project_all(joints, options, db, progress, report);
+  cluster(options, db, progress);
+  db.build.fps = options.fps;
+  db.build.scaling = options.scaling;
+  db.build.views = options.views;
+  db.build.clusters = static_cast<int>(db.cluster_begin.size()) - 1;
+  db.build.seed = options.seed;
+  db.build.created = now_iso();
+  db.build.command = options.command;
+  db.build.build_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  return db;
+}
+
 }  // namespace
 
 std::vector<std::string> collect_motion_files(const std::vector<std::string>& paths) {
@@ -296,32 +386,21 @@ std::vector<std::string> collect_motion_files(const std::vector<std::string>& pa
 
 DatabaseContents build_database(const std::vector<std::string>& files, const BuildOptions& options,
                                 const BuildProgress& progress, BuildReport& report) {
-  if (!(options.fps > 0.0 && options.fps <= 1000.0))
-    throw InputError("--fps", "must be between 0 and 1000");
+  check_fps(options);
   const auto started = std::chrono::steady_clock::now();
-  DatabaseContents db;
-  db.views = make_views(options.views);
   std::vector<ClipFrames> clips = read_all(files, options, progress, report);
-  std::vector<std::array<glm::vec3, kBodyJoints>> joints;
-  gather(clips, db, joints);
-  if (db.frames.empty()) {
-    throw InputError("",
-                     "no usable motion in " + std::to_string(files.size()) + " file(s)" +
-                         (report.skipped.empty() ? std::string()
-                                                 : "; first problem: " + report.skipped.front()));
-  }
-  project_all(joints, options, db, progress, report);
-  cluster(options, db, progress);
-  db.build.fps = options.fps;
-  db.build.scaling = options.scaling;
-  db.build.views = options.views;
-  db.build.clusters = static_cast<int>(db.cluster_begin.size()) - 1;
-  db.build.seed = options.seed;
-  db.build.created = now_iso();
-  db.build.command = options.command;
-  db.build.build_seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-  return db;
+  return assemble(clips, options, progress, report, std::to_string(files.size()) + " file(s)",
+                  started);
+}
+
+DatabaseContents build_database_from_bodies(const std::vector<BodySequence>& sequences,
+                                            const BuildOptions& options,
+                                            const BuildProgress& progress, BuildReport& report) {
+  check_fps(options);
+  const auto started = std::chrono::steady_clock::now();
+  std::vector<ClipFrames> clips = clips_from_bodies(sequences, options, progress, report);
+  return assemble(clips, options, progress, report,
+                  std::to_string(sequences.size()) + " sequence(s)", started);
 }
 
 }  // namespace mocap::posedb

@@ -1,13 +1,18 @@
 #pragma once
 // Builds the pose database from mocap files: read, map to the 15-joint body, resample, turn each
-// frame to face +Z, project through every virtual camera, normalise, cluster.
+// frame to face +Z, project through every virtual camera, normalise, cluster. Motion that has
+// joint positions only (no skeleton, e.g. HumanEva-I) enters at the mapped-body step.
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include <glm/vec3.hpp>
+
+#include "core/body15.hpp"
 #include "posedb/database_writer.hpp"
 
 namespace mocap::posedb {
@@ -44,5 +49,23 @@ std::vector<std::string> collect_motion_files(const std::vector<std::string>& pa
 // throws InputError when no file at all could be used.
 DatabaseContents build_database(const std::vector<std::string>& files, const BuildOptions& options,
                                 const BuildProgress& progress, BuildReport& report);
+
+// Motion known only as the 15 body joints' positions, already mapped from its source.
+struct BodySequence {
+  std::string name;     // unique among the sequences, e.g. "Train/S1 Walking 1 chunk0"
+  std::string source;   // file or data set it came from
+  std::string family;   // e.g. "humaneva"
+  std::string mapping;  // how the body joints were made from the source's joints
+  double fps = 0.0;     // source frame rate
+  std::vector<std::array<glm::vec3, kBodyJoints>> frames;  // world, metres, y up
+};
+
+// Builds the database contents from position-only motion: resampled to options.fps by linear
+// interpolation of the positions, then faced, projected and clustered exactly as mocap files.
+// Its clips have an empty skeleton and no rotations. A sequence with no frames, no frame rate or
+// a non-finite position is skipped and listed in `report`; throws InputError when none is usable.
+DatabaseContents build_database_from_bodies(const std::vector<BodySequence>& sequences,
+                                            const BuildOptions& options,
+                                            const BuildProgress& progress, BuildReport& report);
 
 }  // namespace mocap::posedb
