@@ -64,12 +64,24 @@ glm::quat camera_rotation(const VirtualCamera& c) {
 
 }  // namespace
 
+void InputNoise::apply(const Condition& condition, recon::BodyXyc& body) {
+  float top = std::numeric_limits<float>::max(), bottom = -top;
+  for (int j = 0; j < kBodyJoints; ++j) {
+    top = std::min(top, body[3 * j + 1]);
+    bottom = std::max(bottom, body[3 * j + 1]);
+  }
+  const float sigma = condition.noise * (bottom - top);
+  for (int j = 0; j < kBodyJoints; ++j) {
+    body[3 * j] += sigma * gauss_(rng_);
+    body[3 * j + 1] += sigma * gauss_(rng_);
+    if (j != index(Joint::root) && uniform_(rng_) < condition.dropout) body[3 * j + 2] = 0.0f;
+  }
+}
+
 RenderedSequence render(const TruthSequence& seq, const VirtualCamera& cam, const Image& image,
                         const Condition& cond, std::uint64_t seed) {
   RenderedSequence out;
-  std::mt19937_64 rng(seed);
-  std::normal_distribution<float> gauss(0.0f, 1.0f);
-  std::uniform_real_distribution<float> uniform(0.0f, 1.0f);
+  InputNoise noise(seed);
   const glm::quat rotation = camera_rotation(cam);
   const float focal = 0.5f * static_cast<float>(image.width) /
                       std::tan(glm::radians(image.horizontal_fov_deg) / 2.0f);
@@ -80,22 +92,14 @@ RenderedSequence render(const TruthSequence& seq, const VirtualCamera& cam, cons
                              root.z + cam.distance_m * std::cos(yaw));
     Body camera_frame;
     recon::BodyXyc xyc;
-    float top = std::numeric_limits<float>::max(), bottom = -top;
     for (int j = 0; j < kBodyJoints; ++j) {
       camera_frame[j] = rotation * (world[j] - position);
       const glm::vec3& p = camera_frame[j];
       xyc[3 * j] = focal * p.x / p.z + 0.5f * static_cast<float>(image.width);
       xyc[3 * j + 1] = focal * p.y / p.z + 0.5f * static_cast<float>(image.height);
       xyc[3 * j + 2] = p.z > 0.1f ? 1.0f : 0.0f;
-      top = std::min(top, xyc[3 * j + 1]);
-      bottom = std::max(bottom, xyc[3 * j + 1]);
     }
-    const float sigma = cond.noise * (bottom - top);
-    for (int j = 0; j < kBodyJoints; ++j) {
-      xyc[3 * j] += sigma * gauss(rng);
-      xyc[3 * j + 1] += sigma * gauss(rng);
-      if (j != index(Joint::root) && uniform(rng) < cond.dropout) xyc[3 * j + 2] = 0.0f;
-    }
+    noise.apply(cond, xyc);
     out.input.push_back(xyc);
     out.truth_camera.push_back(camera_frame);
   }

@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cstdint>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -46,6 +47,20 @@ struct Condition {
   float noise = 0.0f;    // Gaussian σ as a fraction of the 2D bounding-box height
   float dropout = 0.0f;  // chance that a joint (root excepted) is missing
   std::string label() const;
+};
+
+// The 2D noise and drop-out of a Condition, applied frame after frame from one random stream.
+class InputNoise {
+ public:
+  explicit InputNoise(std::uint64_t seed) : rng_(seed) {}
+  // Adds Gaussian noise of σ = condition.noise × the height of the joints' 2D box to every
+  // joint and marks joints other than the root missing with chance condition.dropout.
+  void apply(const Condition& condition, recon::BodyXyc& body);
+
+ private:
+  std::mt19937_64 rng_;
+  std::normal_distribution<float> gauss_{0.0f, 1.0f};
+  std::uniform_real_distribution<float> uniform_{0.0f, 1.0f};
 };
 
 // One sequence through one camera: the 2D input and the 3D truth in the camera's frame.
