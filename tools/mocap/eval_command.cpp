@@ -17,6 +17,7 @@
 #include "commands.hpp"
 #include "core/input_error.hpp"
 #include "eval/virtual_protocol.hpp"
+#include "eval_configs.hpp"
 #include "eval_report.hpp"
 #include "posedb/builder.hpp"
 #include "posedb/database.hpp"
@@ -27,39 +28,6 @@ namespace {
 
 using nlohmann::json;
 namespace fs = std::filesystem;
-
-// One configuration of the method, compared side by side with the others in one run.
-struct Config {
-  std::string name;
-  std::string description;
-  const posedb::Database* db;
-  recon::MatchOptions match;
-  recon::SequenceOptions sequence;
-};
-
-std::vector<std::string> split_files(const std::string& folder, const std::string& split) {
-  std::ifstream list(fs::path(folder) / "splits.txt");
-  if (!list)
-    throw InputError(folder,
-                     "no splits.txt here: give the cmu31 folder of the shared data with --mocap");
-  std::vector<std::string> files;
-  std::string which, file;
-  while (list >> which >> file) {
-    if (which == split) files.push_back((fs::path(folder) / file).string());
-  }
-  return files;
-}
-
-// The paper's database: the same train clips seen only by the level 1.5 m camera, 30 yaws.
-std::string build_paper_database(const std::string& mocap, const std::string& path) {
-  posedb::BuildOptions options;
-  options.views.heights_m = {1.5f};
-  options.command = "mocap eval virtual (paper database: yaw-only views at 1.5 m)";
-  posedb::BuildReport report;
-  const auto contents = posedb::build_database(split_files(mocap, "train"), options, {}, report);
-  posedb::write_database(contents, path);
-  return path;
-}
 
 struct Job {
   std::size_t config, camera, condition, sequence;
@@ -112,56 +80,6 @@ std::vector<eval::Scores> run_jobs(const std::vector<Config>& configs,
   return summed;
 }
 
-json scores_json(const eval::Scores& s) {
-  return {{"mpjpe_mm", s.mpjpe()},
-          {"pa_mpjpe_mm", s.pa_mpjpe()},
-          {"accel_mm_per_frame2", s.accel()},
-          {"jitter_mm_per_frame2", s.jitter()},
-          {"coverage", s.coverage()},
-          {"frames", s.frames}};
-}
-
-void print_row(const std::string& name, const std::string& what, const eval::Scores& s) {
-  std::cout << "| " << name << " | " << what << " | " << std::fixed << std::setprecision(1)
-            << s.mpjpe() << " | " << s.pa_mpjpe() << " | " << s.accel() << " | " << s.jitter()
-            << " | " << std::setprecision(3) << s.coverage() << " |\n";
-}
-
-std::vector<Config> make_configs(const posedb::Database& full, const posedb::Database& paper,
-                                 double fps) {
-  recon::SequenceOptions base;
-  base.fps = fps;
-  std::vector<Config> configs;
-  Config paper_config{
-      "paper", "yaw-only views at 1.5 m, clusters, greedy w = 4, no smoothing", &paper, {}, base};
-  paper_config.sequence.selection = recon::Selection::greedy;
-  configs.push_back(paper_config);
-  Config nn{
-      "per-frame NN", "all views, nearest neighbour per frame, no smoothing", &full, {}, base};
-  nn.sequence.selection = recon::Selection::nearest;
-  configs.push_back(nn);
-  Config greedy{"greedy", "all views, greedy w = 4, no smoothing", &full, {}, base};
-  greedy.sequence.selection = recon::Selection::greedy;
-  configs.push_back(greedy);
-  Config path_sg{"full: path + SG",
-                 "all views, Viterbi path over candidates, Savitzky-Golay (3, 11)",
-                 &full,
-                 {},
-                 base};
-  path_sg.sequence.selection = recon::Selection::path;
-  path_sg.sequence.smoothing = recon::Smoothing::savitzky_golay;
-  configs.push_back(path_sg);
-  Config path_euro{"full live: path + 1-Euro",
-                   "all views, Viterbi path, 1-Euro (beta 0.4, fc_min 1)",
-                   &full,
-                   {},
-                   base};
-  path_euro.sequence.selection = recon::Selection::path;
-  path_euro.sequence.smoothing = recon::Smoothing::one_euro;
-  configs.push_back(path_euro);
-  return configs;
-}
-
 int virtual_protocol(int argc, char** argv) {
   Args args(
       "mocap eval virtual --db DB [options]",
@@ -185,17 +103,8 @@ int virtual_protocol(int argc, char** argv) {
   const auto started = std::chrono::steady_clock::now();
   const posedb::Database full = posedb::Database::open(args.get("db"));
   const std::string mocap = args.get("mocap");
-  std::string paper_path = args.get("paper-db");
-  const bool temporary_paper = paper_path.empty();
-  if (temporary_paper) {
-    paper_path =
-        (fs::temp_directory_path() / ("mocap-paper-" + std::to_string(::getpid()) + ".mdb"))
-            .string();
-    std::cerr << "building the paper's yaw-only database in " << paper_path << "\n";
-    build_paper_database(mocap, paper_path);
-  }
-  const posedb::Database paper = posedb::Database::open(paper_path);
-  if (temporary_paper) fs::remove(paper_path);  // the mapping stays valid
+  const posedb::Database paper =
+      open_paper_database(args.get("paper-db"), mocap, "mocap eval virtual");
 
   auto truth = eval::load_truth(split_files(mocap, "heldout"), full.build_info().fps);
   if (const long n = args.integer("clips"); n > 0 && static_cast<std::size_t>(n) < truth.size())
@@ -278,7 +187,8 @@ int virtual_protocol(int argc, char** argv) {
 int eval_command(int argc, char** argv) {
   const std::string usage =
       "usage: mocap eval virtual|humaneva ...\n\n"
-      "  virtual    the paper's virtual-video protocol on held-out CMU subjects\n\n"
+      "  virtual    the paper's virtual-video protocol on held-out CMU subjects\n"
+      "  humaneva   HumanEva-I Validate from ground-truth 2D, CMU and HumanEva databases\n\n"
       "Run 'mocap eval SUBCOMMAND --help' for options.\n";
   if (argc < 1) {
     std::cerr << usage;
@@ -286,6 +196,7 @@ int eval_command(int argc, char** argv) {
   }
   const std::string sub = argv[0];
   if (sub == "virtual") return virtual_protocol(argc - 1, argv + 1);
+  if (sub == "humaneva") return humaneva_eval_command(argc - 1, argv + 1);
   if (sub == "--help" || sub == "-h") {
     std::cout << usage;
     return 0;

@@ -1,0 +1,108 @@
+#include "eval_configs.hpp"
+
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+
+#include "core/input_error.hpp"
+
+namespace mocap::cli {
+
+namespace fs = std::filesystem;
+
+std::vector<Config> make_configs(const posedb::Database& full, const posedb::Database& paper,
+                                 double fps) {
+  recon::SequenceOptions base;
+  base.fps = fps;
+  std::vector<Config> configs;
+  Config paper_config{
+      "paper", "yaw-only views at 1.5 m, clusters, greedy w = 4, no smoothing", &paper, {}, base};
+  paper_config.sequence.selection = recon::Selection::greedy;
+  configs.push_back(paper_config);
+  Config nn{
+      "per-frame NN", "all views, nearest neighbour per frame, no smoothing", &full, {}, base};
+  nn.sequence.selection = recon::Selection::nearest;
+  configs.push_back(nn);
+  Config greedy{"greedy", "all views, greedy w = 4, no smoothing", &full, {}, base};
+  greedy.sequence.selection = recon::Selection::greedy;
+  configs.push_back(greedy);
+  Config path_sg{"full: path + SG",
+                 "all views, Viterbi path over candidates, Savitzky-Golay (3, 11)",
+                 &full,
+                 {},
+                 base};
+  path_sg.sequence.selection = recon::Selection::path;
+  path_sg.sequence.smoothing = recon::Smoothing::savitzky_golay;
+  configs.push_back(path_sg);
+  Config path_euro{"full live: path + 1-Euro",
+                   "all views, Viterbi path, 1-Euro (beta 0.4, fc_min 1)",
+                   &full,
+                   {},
+                   base};
+  path_euro.sequence.selection = recon::Selection::path;
+  path_euro.sequence.smoothing = recon::Smoothing::one_euro;
+  configs.push_back(path_euro);
+  return configs;
+}
+
+std::vector<std::string> split_files(const std::string& folder, const std::string& split) {
+  std::ifstream list(fs::path(folder) / "splits.txt");
+  if (!list)
+    throw InputError(folder,
+                     "no splits.txt here: give the cmu31 folder of the shared data with --mocap");
+  std::vector<std::string> files;
+  std::string which, file;
+  while (list >> which >> file) {
+    if (which == split) files.push_back((fs::path(folder) / file).string());
+  }
+  return files;
+}
+
+posedb::BuildOptions paper_build_options(const std::string& command) {
+  posedb::BuildOptions options;
+  options.views.heights_m = {1.5f};
+  options.command = command;
+  return options;
+}
+
+posedb::Database open_temporary_database(const posedb::DatabaseContents& contents,
+                                         const std::string& tag) {
+  const std::string path =
+      (fs::temp_directory_path() / ("mocap-" + tag + "-" + std::to_string(::getpid()) + ".mdb"))
+          .string();
+  posedb::write_database(contents, path);
+  posedb::Database db = posedb::Database::open(path);
+  fs::remove(path);  // the mapping stays valid; nothing is left behind if the run is killed later
+  return db;
+}
+
+posedb::Database open_paper_database(const std::string& given, const std::string& mocap,
+                                     const std::string& command) {
+  if (!given.empty()) return posedb::Database::open(given);
+  std::cerr << "building the paper's yaw-only database from the train split of " << mocap << "\n";
+  posedb::BuildReport report;
+  const auto contents = posedb::build_database(
+      split_files(mocap, "train"),
+      paper_build_options(command + " (paper database: yaw-only views at 1.5 m)"), {}, report);
+  return open_temporary_database(contents, "paper");
+}
+
+nlohmann::json scores_json(const eval::Scores& s) {
+  return {{"mpjpe_mm", s.mpjpe()},
+          {"pa_mpjpe_mm", s.pa_mpjpe()},
+          {"accel_mm_per_frame2", s.accel()},
+          {"jitter_mm_per_frame2", s.jitter()},
+          {"coverage", s.coverage()},
+          {"frames", s.frames}};
+}
+
+void print_row(const std::string& name, const std::string& what, const eval::Scores& s) {
+  std::cout << "| " << name << " | " << what << " | " << std::fixed << std::setprecision(1)
+            << s.mpjpe() << " | " << s.pa_mpjpe() << " | " << s.accel() << " | " << s.jitter()
+            << " | " << std::setprecision(3) << s.coverage() << " |\n";
+}
+
+}  // namespace mocap::cli

@@ -1,0 +1,316 @@
+// `mocap eval humaneva`: the HumanEva-I protocol of ../shared/docs/EVALUATION.md. The
+// configurations of `mocap eval virtual`, run once with the CMU train database (different people
+// and markers: the cross-dataset case) and once with databases built from HumanEva's own Train
+// split (the published methods' setting), on the Validate split's ground-truth 2D with the
+// virtual protocol's noise levels.
+
+#include <chrono>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <map>
+#include <memory>
+
+#include <nlohmann/json.hpp>
+
+#include "cli_args.hpp"
+#include "commands.hpp"
+#include "core/input_error.hpp"
+#include "eval/humaneva_protocol.hpp"
+#include "eval_configs.hpp"
+#include "eval_report.hpp"
+#include "posedb/parallel_chunks.hpp"
+#include "progress_bar.hpp"
+
+namespace mocap::cli {
+namespace {
+
+using nlohmann::json;
+namespace he = io::humaneva;
+
+// The actions the HumanEva databases are built from: the evaluated ones, as VideoPose3D trains
+// (`-a Walk,Jog,Box`).
+std::vector<std::string_view> training_actions() {
+  std::vector<std::string_view> actions;
+  for (const auto& a : eval::kHumanEvaActions) actions.push_back(a.data_name);
+  return actions;
+}
+
+// The databases one row group of the tables uses: the full view set and the paper's.
+struct DatabaseFamily {
+  std::string name;
+  std::string description;
+  posedb::Database full;
+  posedb::Database paper;
+};
+
+// Build options that give the view set, scaling and rate of an existing database.
+posedb::BuildOptions same_views_as(const posedb::BuildInfo& info, const std::string& command,
+                                   int threads) {
+  posedb::BuildOptions options;
+  options.fps = info.fps;
+  options.views = info.views;
+  options.scaling = info.scaling;
+  options.seed = info.seed;
+  options.threads = threads;
+  options.command = command;
+  return options;
+}
+
+posedb::Database build_from_humaneva(const std::vector<posedb::BodySequence>& motion,
+                                     const posedb::BuildOptions& options, const std::string& tag) {
+  posedb::BuildReport report;
+  const auto contents = posedb::build_database_from_bodies(motion, options, {}, report);
+  for (const auto& skipped : report.skipped) std::cerr << "skipped " << skipped << "\n";
+  return open_temporary_database(contents, tag);
+}
+
+constexpr const char* kTrainedOn = "HumanEva-I Train S1-S3, Walk/Jog/Box";
+
+// The HumanEva database with all views: the file given, or one built with the CMU database's
+// view set so that only the motion differs between the two rows of the tables.
+posedb::Database humaneva_full_database(const std::vector<posedb::BodySequence>& motion,
+                                        const posedb::Database& cmu, const std::string& given,
+                                        int threads) {
+  const double fps = cmu.build_info().fps;
+  if (given.empty()) {
+    const std::string command =
+        std::string("mocap eval humaneva (") + kTrainedOn + ", view set of " + cmu.path() + ")";
+    return build_from_humaneva(motion, same_views_as(cmu.build_info(), command, threads),
+                               "humaneva");
+  }
+  posedb::Database db = posedb::Database::open(given);
+  if (db.build_info().fps != fps)
+    throw InputError(given, "built at " + std::to_string(db.build_info().fps) +
+                                " fps, the CMU database at " + std::to_string(fps) +
+                                ": both must have the same rate");
+  return db;
+}
+
+// HumanEva's own databases: the full view set and the paper's.
+DatabaseFamily humaneva_family(const he::Dataset& data, const posedb::Database& cmu,
+                               const std::string& given, int threads) {
+  const auto motion = eval::humaneva_body_sequences(data, he::Split::train, training_actions());
+  std::cerr << "building the HumanEva Train databases from " << motion.size() << " chunks\n";
+  posedb::BuildOptions paper_options =
+      paper_build_options(std::string("mocap eval humaneva (") + kTrainedOn +
+                          ", paper database: yaw-only views at 1.5 m)");
+  paper_options.fps = cmu.build_info().fps;
+  paper_options.threads = threads;
+  return {"HumanEva Train", std::string("built from ") + kTrainedOn,
+          humaneva_full_database(motion, cmu, given, threads),
+          build_from_humaneva(motion, paper_options, "humaneva-paper")};
+}
+
+struct Job {
+  std::size_t family, config, condition, sequence;
+};
+
+// Every (family, configuration, condition) for every sequence, on `threads` threads. A matcher
+// per job: it is cheap to make and keeps scratch space, so it is never shared between threads.
+std::vector<eval::Scores> run_jobs(const std::vector<std::vector<Config>>& configs,
+                                   const std::vector<eval::Condition>& conditions,
+                                   const std::vector<eval::HumanEvaSequence>& sequences,
+                                   int threads) {
+  std::vector<Job> jobs;
+  for (std::size_t f = 0; f < configs.size(); ++f)
+    for (std::size_t c = 0; c < configs[f].size(); ++c)
+      for (std::size_t n = 0; n < conditions.size(); ++n)
+        for (std::size_t s = 0; s < sequences.size(); ++s) jobs.push_back({f, c, n, s});
+  std::map<const posedb::Database*, std::unique_ptr<recon::FrameBones>> bones;
+  for (const auto& family : configs)
+    for (const Config& config : family)
+      if (!bones.contains(config.db))
+        bones[config.db] = std::make_unique<recon::FrameBones>(*config.db);
+  std::vector<eval::Scores> results(jobs.size());
+  ProgressBar bar;
+  posedb::for_each_chunk(
+      jobs.size(), threads,
+      [&](std::size_t i) {
+        const Job& job = jobs[i];
+        const Config& config = configs[job.family][job.config];
+        recon::Matcher matcher(*config.db, config.match);
+        const std::uint64_t seed = 1000003ull * job.sequence + job.condition;  // same for all
+        results[i] = eval::evaluate_sequence(matcher, *bones.at(config.db), sequences[job.sequence],
+                                             conditions[job.condition], config.sequence, seed);
+      },
+      [&](std::size_t done) {
+        bar.update("evaluate", static_cast<double>(done) / static_cast<double>(jobs.size()));
+      });
+  bar.finish();
+  return results;
+}
+
+std::string cell_name(std::string_view action, std::string_view subject) {
+  return std::string(action) + " " + std::string(subject);
+}
+
+void print_cells_header(const std::string& family) {
+  std::cout << "\n## HumanEva-I Validate, " << family
+            << " database: PA-MPJPE mm per action and subject\n\n| configuration | condition |";
+  for (const auto& a : eval::kHumanEvaActions)
+    for (const auto s : eval::kHumanEvaSubjects) std::cout << " " << cell_name(a.label, s) << " |";
+  std::cout << " mean |\n|---|---|";
+  for (std::size_t i = 0; i <= eval::kHumanEvaActions.size() * eval::kHumanEvaSubjects.size(); ++i)
+    std::cout << "---:|";
+  std::cout << "\n";
+}
+
+void print_cells_row(const std::string& config, const std::string& condition,
+                     const eval::HumanEvaTable& table) {
+  std::cout << "| " << config << " | " << condition << " |" << std::fixed << std::setprecision(1);
+  for (const auto& a : eval::kHumanEvaActions)
+    for (const auto s : eval::kHumanEvaSubjects)
+      std::cout << " " << table.cell(s, a.label).pa_mpjpe() << " |";
+  std::cout << " " << table.mean_cell_pa_mpjpe() << " |\n";
+}
+
+json table_json(const eval::HumanEvaTable& table) {
+  json cells = json::object();
+  for (const auto& a : eval::kHumanEvaActions)
+    for (const auto s : eval::kHumanEvaSubjects)
+      cells[cell_name(a.label, s)] = scores_json(table.cell(s, a.label));
+  return {{"cells", cells},
+          {"mean_of_cells_pa_mpjpe_mm", table.mean_cell_pa_mpjpe()},
+          {"all_frames", scores_json(table.all())}};
+}
+
+std::string command_line(int argc, char** argv) {
+  std::string line = "mocap eval humaneva";
+  for (int i = 0; i < argc; ++i) line.append(" ").append(argv[i]);
+  return line;
+}
+
+constexpr const char* kRateNote =
+    "HumanEva is 60 Hz, the databases 24 fps: the 2D input and the 3D truth are both resampled to "
+    "the database rate by linear interpolation, noise is added per evaluated frame, and the "
+    "acceleration error is in mm/frame^2 at that rate";
+constexpr const char* kJointNote =
+    "every Body15 joint is one HumanEva-15 joint, none derived or dropped; MPJPE and PA-MPJPE "
+    "average the 14 non-root joints (root = HumanEva pelvis, torsoDistal, not the mid-hip point; "
+    "head = headDistal)";
+
+// Tables per family and the JSON of every number.
+json report(const std::vector<DatabaseFamily>& families,
+            const std::vector<std::vector<Config>>& configs,
+            const std::vector<eval::Condition>& conditions,
+            const std::vector<eval::HumanEvaSequence>& sequences,
+            const std::vector<eval::Scores>& results) {
+  json out = json::object();
+  std::size_t i = 0;  // results are in job order: family, config, condition, sequence
+  for (std::size_t f = 0; f < families.size(); ++f) {
+    print_cells_header(families[f].name);
+    struct Total {
+      std::string config, condition;
+      eval::Scores scores;
+    };
+    std::vector<Total> totals;
+    json per_config = json::object();
+    for (const Config& config : configs[f]) {
+      json per_condition = json::object();
+      for (const eval::Condition& condition : conditions) {
+        eval::HumanEvaTable table;
+        for (const auto& sequence : sequences) table.add(sequence, results[i++]);
+        print_cells_row(config.name, condition.label(), table);
+        per_condition[condition.label()] = table_json(table);
+        totals.push_back({config.name, condition.label(), table.all()});
+      }
+      per_config[config.name] = {{"description", config.description},
+                                 {"per_condition", per_condition}};
+    }
+    std::cout
+        << "\n## HumanEva-I Validate, " << families[f].name
+        << " database: all frames\n\n| configuration | condition | MPJPE mm | PA-MPJPE mm "
+           "| accel err mm/f² | jitter mm/f² | coverage |\n|---|---|---:|---:|---:|---:|---:|\n";
+    for (const Total& t : totals) print_row(t.config, t.condition, t.scores);
+    out[families[f].name] = {{"description", families[f].description},
+                             {"database_frames", families[f].full.frames().size()},
+                             {"database_projections", families[f].full.projections().rows},
+                             {"database", json::parse(families[f].full.options_json())},
+                             {"paper_database", json::parse(families[f].paper.options_json())},
+                             {"configurations", per_config}};
+  }
+  return out;
+}
+
+json sequences_json(const std::vector<eval::HumanEvaSequence>& sequences) {
+  std::size_t frames = 0;
+  for (const auto& s : sequences) frames += s.input.size();
+  return {{"sequences", sequences.size()}, {"frames", frames}};
+}
+
+}  // namespace
+
+int humaneva_eval_command(int argc, char** argv) {
+  Args args("mocap eval humaneva --db CMU_TRAIN_DB [options]",
+            "HumanEva-I (Validate S1-S3; Walk, Jog, Box; cameras C1-C3) from ground-truth 2D with "
+            "the virtual\nprotocol's noise levels: PA-MPJPE per subject and action, MPJPE, "
+            "acceleration error, once with the\nCMU train database and once with databases built "
+            "from HumanEva's Train split. Prints Markdown\ntables and writes every number as "
+            "JSON.");
+  args.option("db", "FILE",
+              "database built from the CMU train split (mocap db build ... --split "
+              "train)")
+      .option("paper-db", "FILE",
+              "the paper's yaw-only 1.5 m CMU database (built from --mocap when absent)")
+      .option("mocap", "DIR", "cmu31 folder with splits.txt", "../shared/data/mocap/cmu31")
+      .option("humaneva-db", "FILE",
+              "database built from HumanEva Train (built with the --db view set when absent)")
+      .option("data", "DIR", "HumanEva-I in the VideoPose3D format",
+              "../shared/data/eval/humaneva_i_videopose3d")
+      .option("json", "FILE", "where to write all numbers", "eval_humaneva.json")
+      .option("threads", "N", "worker threads", "2")
+      .flag("quick", "2 noise levels instead of 5");
+  int code = 0;
+  if (!args.parse(argc, argv, code)) return code;
+  if (!args.has("db")) throw InputError("--db", "required: a database built from the train split");
+  const auto started = std::chrono::steady_clock::now();
+  const int threads = static_cast<int>(std::clamp(args.integer("threads"), 1L, 64L));
+  const std::string folder = args.get("data");
+  const he::Dataset data = he::load_dataset(folder);
+  const auto cameras = he::load_cameras(std::filesystem::path(folder) / he::kCamerasFile);
+
+  std::vector<DatabaseFamily> families;
+  posedb::Database cmu = posedb::Database::open(args.get("db"));
+  posedb::Database cmu_paper =
+      open_paper_database(args.get("paper-db"), args.get("mocap"), "mocap eval humaneva");
+  DatabaseFamily own = humaneva_family(data, cmu, args.get("humaneva-db"), threads);
+  families.push_back(
+      {"CMU train", "the --db database (cross-dataset)", std::move(cmu), std::move(cmu_paper)});
+  families.push_back(std::move(own));
+  const double fps = families.front().full.build_info().fps;
+
+  std::vector<std::vector<Config>> configs;
+  for (const auto& family : families)
+    configs.push_back(make_configs(family.full, family.paper, fps));
+  const auto conditions = eval::default_conditions(args.has("quick"));
+  const auto sequences = eval::humaneva_validation_sequences(data, cameras, fps);
+  std::cerr << "evaluating " << configs.front().size() << " configurations x " << families.size()
+            << " databases on " << sequences.size() << " sequences (chunk x camera) x "
+            << conditions.size() << " conditions\n";
+  const auto results = run_jobs(configs, conditions, sequences, threads);
+
+  json out = {{"protocol", "humaneva"},
+              {"command", command_line(argc, argv)},
+              {"git_commit", git_commit()},
+              {"machine", machine_description()},
+              {"data", folder},
+              {"evaluation_fps", fps},
+              {"rate", kRateNote},
+              {"joints", kJointNote},
+              {"joint_correspondence", eval::humaneva_joint_correspondence()},
+              {"validation", sequences_json(sequences)}};
+  out["results"] = report(families, configs, conditions, sequences, results);
+  std::cout << "\nJoints: " << kJointNote << ":\n";
+  for (const auto& line : eval::humaneva_joint_correspondence()) std::cout << "- " << line << "\n";
+  std::cout << "\nRate: " << kRateNote << ".\n\nConfigurations:\n";
+  for (const auto& c : configs.front())
+    std::cout << "- " << c.name << ": " << c.description << "\n";
+  out["seconds"] =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  std::ofstream(args.get("json")) << out.dump(2) << "\n";
+  std::cout << "\nAll numbers: " << args.get("json") << "\n";
+  return 0;
+}
+
+}  // namespace mocap::cli
