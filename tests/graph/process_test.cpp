@@ -17,89 +17,14 @@
 #include <thread>
 
 #include "graph_test_util.hpp"
-
-extern char** environ;
+#include "support/mocap_process.hpp"
 
 namespace mocap::graph {
 namespace {
 
 using namespace std::chrono_literals;
+using test::Mocap;
 using testing::TempDir;
-
-// A child process running `mocap ARGS...` with stdout and stderr going to files.
-class Mocap {
- public:
-  Mocap(const TempDir& dir, const std::string& name, std::vector<std::string> args,
-        std::vector<std::string> extra_env = {})
-      : out_(dir.file(name + ".out")), err_(dir.file(name + ".err")) {
-    args.insert(args.begin(), MOCAP_BINARY);
-    std::vector<char*> argv;
-    for (auto& a : args) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    std::vector<std::string> env;
-    for (char** e = environ; *e; ++e) {
-      if (std::strncmp(*e, "MOCAP_", 6) != 0) env.emplace_back(*e);  // no inherited plugin path
-    }
-    env.insert(env.end(), extra_env.begin(), extra_env.end());
-    std::vector<char*> envp;
-    for (auto& e : env) envp.push_back(e.data());
-    envp.push_back(nullptr);
-    posix_spawn_file_actions_t files;
-    posix_spawn_file_actions_init(&files);
-    posix_spawn_file_actions_addopen(&files, 1, out_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    posix_spawn_file_actions_addopen(&files, 2, err_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    const int error = posix_spawn(&pid_, MOCAP_BINARY, &files, nullptr, argv.data(), envp.data());
-    posix_spawn_file_actions_destroy(&files);
-    if (error != 0)
-      throw std::runtime_error(std::string("cannot start mocap: ") + std::strerror(error));
-  }
-  ~Mocap() {
-    if (pid_ > 0) {
-      kill(pid_, SIGKILL);  // its children follow (PR_SET_PDEATHSIG)
-      waitpid(pid_, nullptr, 0);
-    }
-  }
-  Mocap(const Mocap&) = delete;
-  Mocap& operator=(const Mocap&) = delete;
-
-  pid_t pid() const { return pid_; }
-  // The exit code (128 + signal when killed), or nullopt after `timeout` (the process is killed).
-  std::optional<int> wait(std::chrono::milliseconds timeout) {
-    const auto deadline = std::chrono::steady_clock::now() + timeout;
-    while (std::chrono::steady_clock::now() < deadline) {
-      int status = 0;
-      if (waitpid(pid_, &status, WNOHANG) == pid_) {
-        pid_ = -1;
-        return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-      }
-      std::this_thread::sleep_for(20ms);
-    }
-    return std::nullopt;
-  }
-  std::string err() const { return testing::read_file(err_); }
-  std::string out() const { return testing::read_file(out_); }
-  // Waits until stderr matches `pattern`; returns the first capture group (or "").
-  std::optional<std::string> wait_for_log(const std::string& pattern,
-                                          std::chrono::milliseconds timeout,
-                                          std::size_t occurrence = 1) const {
-    const std::regex re(pattern);
-    const auto deadline = std::chrono::steady_clock::now() + timeout;
-    while (std::chrono::steady_clock::now() < deadline) {
-      const std::string text = err();
-      std::size_t seen = 0;
-      for (auto it = std::sregex_iterator(text.begin(), text.end(), re);
-           it != std::sregex_iterator(); ++it) {
-        if (++seen == occurrence) return it->size() > 1 ? (*it)[1].str() : std::string();
-      }
-      std::this_thread::sleep_for(20ms);
-    }
-    return std::nullopt;
-  }
-
- private:
-  std::string out_, err_;
-  pid_t pid_ = -1;
-};
 
 std::string endpoint(const std::string& kind, const TempDir& dir, const std::string& name) {
   if (kind == "ipc") return "ipc://" + dir.file(name);

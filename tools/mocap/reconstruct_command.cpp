@@ -55,7 +55,8 @@ void set_param(graph::GraphSpec& spec, std::string_view type, const std::string&
 
 void configure(graph::GraphSpec& spec, const Args& args, const fs::path& out) {
   set_param(spec, "source.openpose_json", "path", args.positionals()[0]);
-  if (args.has("fps")) set_param(spec, "source.openpose_json", "fps", args.get("fps"));
+  for (const char* type : {"source.openpose_json", "sink.bvh", "sink.overlay"})
+    set_param(spec, type, "fps", args.get("fps"));
   for (const char* type :
        {"recon.scaler", "recon.matcher", "recon.temporal_selector", "sink.bvh"}) {
     set_param(spec, type, "db", args.get("db"));

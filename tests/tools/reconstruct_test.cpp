@@ -1,0 +1,120 @@
+// `mocap reconstruct` end to end, through the built binary: real OpenPose JSON of several people,
+// with a malformed file and a missing frame: the run reports both, goes on, and writes one line
+// per input frame, a BVH per person and a summary.
+
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "core/body15.hpp"
+#include "motion/bvh.hpp"
+#include "support/mocap_process.hpp"
+#include "support/shared_data.hpp"
+
+namespace mocap {
+namespace {
+
+namespace fs = std::filesystem;
+using namespace std::chrono_literals;
+
+class ReconstructTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    const fs::path mocap = test::shared_data() / "mocap" / "cmu31";
+    const fs::path json = test::shared_data() / "eval" / "openpose_json" / "json";
+    if (!fs::exists(mocap / "08_01.bvh") || !fs::exists(json)) return;
+    dir_ = std::make_unique<test::TempDir>();
+    test::Mocap build(
+        *dir_, "build",
+        {"db", "build", (mocap / "08_01.bvh").string(), (mocap / "09_12.bvh").string(),
+         "--clusters", "32", "--out", dir_->file("db.mdb")});
+    ASSERT_EQ(build.wait(120s), 0) << build.err();
+    // The first 40 frames of the badminton clip; frame 7 truncated, frame 12 missing.
+    fs::create_directories(dir_->path() / "input");
+    std::vector<fs::path> files;
+    for (const auto& e : fs::directory_iterator(json)) files.push_back(e.path());
+    std::sort(files.begin(), files.end());
+    for (std::size_t i = 0; i < 40; ++i) {
+      const fs::path target = dir_->path() / "input" / files[i].filename();
+      if (i == 12) continue;
+      if (i == 7) {
+        const std::string text = test::read_file(files[i].string());
+        test::write_file(target.string(), text.substr(0, text.size() / 2));
+      } else {
+        fs::copy_file(files[i], target);
+      }
+    }
+  }
+  static void TearDownTestSuite() { dir_.reset(); }
+  void SetUp() override {
+    if (!dir_)
+      GTEST_SKIP()
+          << "shared data absent (../shared/data/mocap/cmu31, ../shared/data/eval/openpose_json)";
+  }
+  static inline std::unique_ptr<test::TempDir> dir_;
+};
+
+TEST_F(ReconstructTest, DamagedInputIsReportedAndEveryFrameIsWritten) {
+  const std::string out = dir_->file("out");
+  test::Mocap run(*dir_, "reconstruct",
+                  {"reconstruct", (dir_->path() / "input").string(), "--db", dir_->file("db.mdb"),
+                   "--out", out});
+  ASSERT_EQ(run.wait(300s), 0) << run.err();
+  const std::string err = run.err();
+  EXPECT_NE(err.find("000000000007_keypoints.json"), std::string::npos)
+      << err;                                           // the truncated file
+  EXPECT_NE(err.find("12"), std::string::npos) << err;  // the missing frame
+
+  const auto lines = test::read_lines(out + "/poses.jsonl");
+  ASSERT_EQ(lines.size(), 40u);
+  int people_frames = 0;
+  for (std::size_t i = 0; i < lines.size(); ++i) {
+    const auto j = nlohmann::json::parse(lines[i]);
+    EXPECT_EQ(j.at("frame").get<std::size_t>(), i);
+    EXPECT_NEAR(j.at("time").get<double>(), static_cast<double>(i) / 30.0, 1e-6);
+    for (const auto& p : j.at("people")) {
+      ++people_frames;
+      ASSERT_EQ(p.at("joints").size(), static_cast<std::size_t>(kBodyJoints));
+      const auto root = p.at("joints").at("root");
+      EXPECT_EQ(root[0].get<double>(), 0.0);  // root-relative
+      const auto head = p.at("joints").at("head");
+      EXPECT_LT(head[1].get<double>(), -0.3);  // the head is above the root (y down)
+    }
+    if (i == 7 || i == 12) {
+      EXPECT_TRUE(j.at("people").empty()) << "frame " << i;
+    }
+  }
+  EXPECT_GT(people_frames, 38 * 6);  // 7-12 people in every good frame
+
+  const auto summary = nlohmann::json::parse(test::read_file(out + "/summary.json"));
+  EXPECT_EQ(summary.at("frames"), 40);
+  EXPECT_GE(summary.at("people").get<int>(), 7);
+  EXPECT_TRUE(summary.at("completed").get<bool>());
+  EXPECT_TRUE(summary.at("nodes").contains("match"));
+
+  int bvh_files = 0;
+  for (const auto& e : fs::directory_iterator(out)) {
+    if (e.path().extension() != ".bvh") continue;
+    ++bvh_files;
+    const motion::Clip clip = motion::read_bvh(e.path().string());
+    EXPECT_GT(clip.frame_count, 0) << e.path();
+    EXPECT_EQ(clip.skeleton.joint_count(), 38) << e.path();  // the cgspeed skeleton with End Sites
+  }
+  EXPECT_GE(bvh_files, 7);
+}
+
+TEST_F(ReconstructTest, MissingDatabaseOrInputGivesAClearError) {
+  test::Mocap no_db(*dir_, "no_db",
+                    {"reconstruct", (dir_->path() / "input").string(), "--db",
+                     dir_->file("absent.mdb"), "--out", dir_->file("x")});
+  EXPECT_EQ(no_db.wait(30s), 1);
+  EXPECT_NE(no_db.err().find("mocap db build"), std::string::npos) << no_db.err();
+  test::Mocap no_input(*dir_, "no_input",
+                       {"reconstruct", dir_->file("nowhere"), "--db", dir_->file("db.mdb"), "--out",
+                        dir_->file("y")});
+  EXPECT_EQ(no_input.wait(30s), 1);
+  EXPECT_NE(no_input.err().find("nowhere"), std::string::npos) << no_input.err();
+}
+
+}  // namespace
+}  // namespace mocap
