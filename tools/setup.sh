@@ -16,7 +16,7 @@ for arg in "$@"; do
   case "$arg" in
     --no-install) install=0 ;;
     -h|--help)
-      sed -n '2,9p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'
+      sed -n '2,8p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'
       echo
       echo "Debian packages it installs:"
       "$0" --list-packages | tr '\n' ' ' | fold -s -w 96
@@ -36,7 +36,9 @@ packages=(
   libflann-dev liblz4-dev                               # FLANN nearest-neighbour search
   libfaiss-dev libblas-dev liblapack-dev                # FAISS search (measured against FLANN)
   libzmq3-dev cppzmq-dev libyaml-cpp-dev                # graph framework: ZeroMQ edges, YAML graphs
-  python3 python3-zmq                                   # the wire-format test client
+  python3 python3-zmq python3-numpy                     # wire-format client; NumPy cross-check of the npz reader
+  libopencv-dev                                         # images and video: overlay, video sources
+  blender                                               # a real BVH importer for the tests
   clang-format                                          # code style
 )
 
@@ -45,7 +47,11 @@ if [[ " $* " == *" --list-packages "* ]]; then
   exit 0
 fi
 
-log() { printf '\033[1m==> %s\033[0m\n' "$*" >&2; }
+if [[ -t 2 ]]; then
+  log() { printf '\033[1m==> %s\033[0m\n' "$*" >&2; }
+else
+  log() { printf '==> %s\n' "$*" >&2; }
+fi
 
 if (( install )); then
   missing=()
