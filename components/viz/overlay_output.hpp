@@ -1,0 +1,43 @@
+#pragma once
+// Where overlay pictures go: an MP4 video (OpenCV VideoWriter, MPEG-4 Part 2 "mp4v", playable
+// without extra codecs) and/or a PNG snapshot every N pictures.
+
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "core/image_buffer.hpp"
+
+namespace mocap::viz {
+
+struct OverlayOutputOptions {
+  std::string video;    // MP4 file; empty: no video
+  double fps = 30.0;    // the video's frame rate
+  int png_every = 0;    // a PNG of every Nth picture (the first included); 0: none
+  std::string png_dir;  // where the PNGs go (created when missing): overlay_<frame>.png
+};
+
+class OverlayOutput {
+ public:
+  // Creates the PNG folder. Throws InputError naming it when that fails, std::invalid_argument
+  // when PNGs are asked for without a folder or the frame rate is not positive.
+  explicit OverlayOutput(OverlayOutputOptions options);
+  ~OverlayOutput();
+  OverlayOutput(OverlayOutput&&) noexcept;
+  OverlayOutput& operator=(OverlayOutput&&) noexcept;
+
+  // Writes one picture (every picture of a run has the same size; any pixel format). The video
+  // is opened on the first picture. Throws InputError naming the file when it cannot be written.
+  void write(const ImageBuffer& picture, std::int64_t frame);
+  // Finishes the video file; idempotent.
+  void close();
+
+  std::int64_t pictures() const;  // written so far
+  std::int64_t pngs() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace mocap::viz

@@ -1,0 +1,282 @@
+// The overlay renderer draws each person in their colour where they belong (2D on the left, 3D on
+// the right), and the input joiner pairs messages by frame and counts what it must drop.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "viz/overlay_inputs.hpp"
+#include "viz/overlay_renderer.hpp"
+
+namespace mocap::viz {
+namespace {
+
+// A standing body, metres, camera axes (y down), root at the origin.
+std::array<glm::vec3, kBodyJoints> standing_body() {
+  std::array<glm::vec3, kBodyJoints> b;
+  auto set = [&](Joint j, float x, float y) { b[static_cast<size_t>(index(j))] = {x, y, 0.0f}; };
+  set(Joint::head, 0.0f, -0.75f);
+  set(Joint::neck, 0.0f, -0.5f);
+  set(Joint::right_shoulder, -0.2f, -0.5f);
+  set(Joint::right_elbow, -0.25f, -0.2f);
+  set(Joint::right_wrist, -0.3f, 0.05f);
+  set(Joint::left_shoulder, 0.2f, -0.5f);
+  set(Joint::left_elbow, 0.25f, -0.2f);
+  set(Joint::left_wrist, 0.3f, 0.05f);
+  set(Joint::right_hip, -0.1f, 0.0f);
+  set(Joint::right_knee, -0.12f, 0.45f);
+  set(Joint::right_ankle, -0.12f, 0.9f);
+  set(Joint::left_hip, 0.1f, 0.0f);
+  set(Joint::left_knee, 0.12f, 0.45f);
+  set(Joint::left_ankle, 0.12f, 0.9f);
+  set(Joint::root, 0.0f, 0.0f);
+  return b;
+}
+
+// COCO-17 keypoints of the standing body drawn at `x0` pixels, 300 pixels a metre.
+Person2D person2d(int id, float x0) {
+  const auto b = standing_body();
+  auto at = [&](Joint j) {
+    const glm::vec3 p = b[static_cast<size_t>(index(j))];
+    return Keypoint2D{x0 + 300.0f * p.x, 360.0f + 300.0f * p.y, 0.9f};
+  };
+  Person2D p;
+  p.id = id;
+  const Keypoint2D head = at(Joint::head);
+  p.joints = {head,
+              head,
+              head,
+              {head.x + 10, head.y, 0.9f},
+              {head.x - 10, head.y, 0.9f},
+              at(Joint::left_shoulder),
+              at(Joint::right_shoulder),
+              at(Joint::left_elbow),
+              at(Joint::right_elbow),
+              at(Joint::left_wrist),
+              at(Joint::right_wrist),
+              at(Joint::left_hip),
+              at(Joint::right_hip),
+              at(Joint::left_knee),
+              at(Joint::right_knee),
+              at(Joint::left_ankle),
+              at(Joint::right_ankle)};
+  p.box = {x0 - 100, 100, 200, 560};
+  return p;
+}
+
+// Is there a pixel within `radius` of `at` whose colour is close to `colour`?
+bool colour_near(const ImageBuffer& image, glm::vec2 at, Rgb colour, int radius = 2) {
+  for (int dy = -radius; dy <= radius; ++dy) {
+    for (int dx = -radius; dx <= radius; ++dx) {
+      const int x = static_cast<int>(std::lround(at.x)) + dx;
+      const int y = static_cast<int>(std::lround(at.y)) + dy;
+      if (x < 0 || y < 0 || x >= image.width() || y >= image.height()) continue;
+      const auto* p = reinterpret_cast<const std::uint8_t*>(image.data()) +
+                      static_cast<size_t>(y) * image.stride() + static_cast<size_t>(x) * 3;
+      if (std::abs(p[0] - colour.b) + std::abs(p[1] - colour.g) + std::abs(p[2] - colour.r) < 30)
+        return true;
+    }
+  }
+  return false;
+}
+
+int pixels_of(const ImageBuffer& image, Rgb colour, int x_begin, int x_end) {
+  int count = 0;
+  for (int y = 0; y < image.height(); ++y) {
+    for (int x = x_begin; x < x_end; ++x) {
+      const auto* p = reinterpret_cast<const std::uint8_t*>(image.data()) +
+                      static_cast<size_t>(y) * image.stride() + static_cast<size_t>(x) * 3;
+      count += (p[0] == colour.b && p[1] == colour.g && p[2] == colour.r) ? 1 : 0;
+    }
+  }
+  return count;
+}
+
+TEST(IdColour, StableDistinctAndGreyWhenUntracked) {
+  EXPECT_EQ(id_colour(4), id_colour(4));
+  for (int id = 0; id < 20; ++id) {
+    const Rgb a = id_colour(id), b = id_colour(id + 1);
+    EXPECT_GT(std::abs(a.r - b.r) + std::abs(a.g - b.g) + std::abs(a.b - b.b), 60) << id;
+  }
+  EXPECT_EQ(id_colour(-1), (Rgb{200, 200, 200}));
+}
+
+TEST(OverlayRenderer, TwoPeopleDrawnInTheirColoursOnBothPanels) {
+  const OverlayRenderer renderer(OverlayOptions{1280, 720});
+  ASSERT_EQ(renderer.height(), 480);
+  ASSERT_EQ(renderer.width(), 2 * 854);  // 1280 x 720 scaled to 480 high, even width
+  People2D people2d;
+  people2d.layout = LayoutId::coco17;
+  people2d.people = {person2d(2, 400.0f), person2d(7, 900.0f)};
+  People3D people3d;
+  for (int id : {7, 2}) {  // listed in the other order: the 2D boxes decide left and right
+    Person3D p;
+    p.id = id;
+    p.positions = standing_body();
+    people3d.people.push_back(p);
+  }
+  const ImageBuffer image = renderer.render(people2d, people3d, {}, {42, 25.0});
+  ASSERT_EQ(image.width(), renderer.width());
+  ASSERT_EQ(image.format(), PixelFormat::bgr8);
+  const Rgb two = id_colour(2), seven = id_colour(7);
+  // Left panel: each person's neck-root line midway, and the colours stay on their own side.
+  for (auto [colour, x0] : {std::pair{two, 400.0f}, std::pair{seven, 900.0f}}) {
+    const glm::vec2 mid = renderer.left_point({x0, 360.0f - 300.0f * 0.25f}, 1280, 720);
+    EXPECT_TRUE(colour_near(image, mid, colour)) << "2D at " << x0;
+    const glm::vec2 knee =
+        renderer.left_point({x0 + 300.0f * 0.12f, 360.0f + 300.0f * 0.45f}, 1280, 720);
+    EXPECT_TRUE(colour_near(image, knee, colour)) << "2D knee at " << x0;
+  }
+  const int half = renderer.panel_width();
+  EXPECT_GT(pixels_of(image, two, 0, half / 2), 50);
+  EXPECT_EQ(pixels_of(image, two, 2 * half / 3, half), 0);
+  EXPECT_GT(pixels_of(image, seven, half / 2, half), 50);
+  // Right panel: person 2 in slot 0 (left), person 7 in slot 1, along the spine.
+  for (auto [colour, slot] : {std::pair{two, 0}, std::pair{seven, 1}}) {
+    const glm::vec2 spine = renderer.right_point({0.0f, -0.25f, 0.0f}, slot, 2);
+    EXPECT_GE(spine.x, half);
+    EXPECT_TRUE(colour_near(image, spine, colour)) << "3D slot " << slot;
+  }
+  EXPECT_GT(pixels_of(image, two, half, 2 * half), 50);
+  EXPECT_GT(pixels_of(image, seven, half, 2 * half), 50);
+}
+
+TEST(OverlayRenderer, VideoFrameIsTheLeftBackgroundInAnyPixelFormat) {
+  OverlayOptions options;
+  options.canvas_width = 640;  // ignored: the video frame's size decides
+  const OverlayRenderer renderer(options);
+  ImageBuffer video(160, 90, PixelFormat::rgb8);
+  auto pixels = video.pixels_for_writing();
+  for (std::size_t i = 0; i < pixels.size(); i += 3) pixels[i + 1] = std::byte{180};  // green
+  const ImageBuffer image = renderer.render({}, {}, video, {0, 0.0});
+  // The panel keeps the canvas's shape (426 x 480, the output size is fixed for a run): the 16:9
+  // video fills its width, centred, with bands above and below.
+  const float right_edge = float(renderer.panel_width()) - 3.0f;
+  EXPECT_TRUE(colour_near(image, {right_edge, 240.0f}, {0, 180, 0}, 0));
+  EXPECT_TRUE(colour_near(image, renderer.left_point({150, 80}, 160, 90), {0, 180, 0}, 0));
+  EXPECT_FALSE(colour_near(image, {right_edge, 470.0f}, {0, 180, 0}, 0));
+  // The right panel is not the video.
+  EXPECT_FALSE(colour_near(image, {right_edge + 8.0f, 240.0f}, {0, 180, 0}, 0));
+}
+
+TEST(OverlayRenderer, MissingJointsAndEmptyFramesDraw) {
+  const OverlayRenderer renderer(OverlayOptions{});
+  People2D people2d;
+  people2d.layout = LayoutId::body25;
+  Person2D p = person2d(3, 600.0f);
+  p.joints.resize(25);  // a BODY_25 person with everything but a few points missing
+  for (std::size_t k = 8; k < 25; ++k) p.joints[k] = {NAN, NAN, 0.0f};
+  people2d.people.push_back(p);
+  People3D people3d;
+  Person3D q;
+  q.id = 3;
+  q.positions = standing_body();
+  q.positions[index(Joint::left_wrist)] = glm::vec3(NAN);
+  people3d.people.push_back(q);
+  EXPECT_NO_THROW(renderer.render(people2d, people3d, {}, {1, 0.0}));
+  EXPECT_NO_THROW(renderer.render({}, {}, {}, {2, 0.0}));
+  EXPECT_THROW(OverlayRenderer(OverlayOptions{8, 720, 480}), std::invalid_argument);
+}
+
+// A camera looking down 52 degrees sees a standing person tilted; upright_positions stands them
+// up again (head straight above the root, feet straight below), keeping left and right.
+TEST(UprightPositions, RemovesTheTiltOfACameraLookingDown) {
+  const auto standing = standing_body();  // image axes, y down, facing the camera
+  // Body frame (y up, facing +Z) to a level camera on +Z: x stays, y and z flip; then the
+  // camera pitches down about its x axis.
+  const glm::quat level_camera = glm::angleAxis(glm::pi<float>(), glm::vec3(1, 0, 0));
+  for (float pitch_deg : {0.0f, 21.4f, 52.0f, -10.0f}) {
+    const glm::quat to_camera =
+        glm::angleAxis(glm::radians(pitch_deg), glm::vec3(1, 0, 0)) * level_camera;
+    Person3D person;
+    person.root.rotation = to_camera;
+    for (int j = 0; j < kBodyJoints; ++j) {
+      const glm::vec3 body = glm::inverse(level_camera) * standing[static_cast<size_t>(j)];
+      person.positions[static_cast<size_t>(j)] = to_camera * body;
+    }
+    const auto upright = upright_positions(person);
+    for (int j = 0; j < kBodyJoints; ++j) {
+      EXPECT_LT(glm::distance(upright[static_cast<size_t>(j)], standing[static_cast<size_t>(j)]),
+                1e-5f)
+          << "pitch " << pitch_deg << " joint " << j;
+    }
+  }
+  Person3D unset;  // identity rotation: left as it is
+  unset.positions = standing;
+  EXPECT_EQ(upright_positions(unset), standing);
+}
+
+// --- joining the inputs by frame
+
+template <class T>
+std::shared_ptr<const T> message(std::int64_t frame) {
+  auto m = std::make_shared<T>();
+  m->header.frame = frame;
+  return m;
+}
+
+TEST(OverlayInputs, FramesAreReadyWhenBothPeopleArrivedInAnyOrder) {
+  OverlayInputs inputs(8, false);
+  inputs.add(message<People3D>(0));
+  EXPECT_TRUE(inputs.take_ready().empty());
+  inputs.add(message<People2D>(0));
+  inputs.add(message<People2D>(1));
+  auto ready = inputs.take_ready();
+  ASSERT_EQ(ready.size(), 1u);
+  EXPECT_EQ(ready[0].frame, 0);
+  inputs.add(message<People3D>(1));
+  ready = inputs.take_ready();
+  ASSERT_EQ(ready.size(), 1u);
+  EXPECT_EQ(ready[0].frame, 1);
+  EXPECT_EQ(inputs.dropped(), 0);
+  EXPECT_EQ(inputs.pending(), 0u);
+}
+
+TEST(OverlayInputs, AFrameSkippedByOneStreamIsDroppedOnceALaterOneIsReady) {
+  OverlayInputs inputs(8, false);
+  inputs.add(message<People2D>(0));
+  inputs.add(message<People2D>(2));  // 2D skipped frame 1
+  inputs.add(message<People3D>(0));
+  inputs.add(message<People3D>(1));
+  inputs.add(message<People3D>(2));
+  const auto ready = inputs.take_ready();
+  ASSERT_EQ(ready.size(), 2u);
+  EXPECT_EQ(ready[1].frame, 2);
+  EXPECT_EQ(inputs.dropped(), 1);
+}
+
+TEST(OverlayInputs, BoundedWhenOneStreamStalls) {
+  OverlayInputs inputs(4, false);
+  for (int f = 0; f < 10; ++f) inputs.add(message<People3D>(f));
+  EXPECT_EQ(inputs.pending(), 4u);
+  EXPECT_EQ(inputs.dropped(), 6);
+}
+
+TEST(OverlayInputs, VideoIsWaitedForOnlyWhenAskedAndUnusedVideoIsNotADrop) {
+  OverlayInputs waits(8, true);
+  waits.add(message<People2D>(0));
+  waits.add(message<People3D>(0));
+  EXPECT_TRUE(waits.take_ready().empty());
+  waits.add(message<VideoFrame>(0));
+  const auto ready = waits.take_ready();
+  ASSERT_EQ(ready.size(), 1u);
+  EXPECT_TRUE(ready[0].video);
+  OverlayInputs takes_what_came(8, false);
+  takes_what_came.add(message<VideoFrame>(0));  // the detector skipped this one
+  takes_what_came.add(message<VideoFrame>(1));
+  takes_what_came.add(message<People2D>(1));
+  takes_what_came.add(message<People3D>(1));
+  const auto drawn = takes_what_came.take_ready();
+  ASSERT_EQ(drawn.size(), 1u);
+  EXPECT_TRUE(drawn[0].video);
+  EXPECT_EQ(takes_what_came.dropped(), 0);
+  // At the end, frames with both people are drawn even without their video.
+  waits.add(message<People2D>(5));
+  waits.add(message<People3D>(5));
+  waits.add(message<People3D>(6));
+  EXPECT_EQ(waits.take_remaining().size(), 1u);
+  EXPECT_EQ(waits.dropped(), 1);
+}
+
+}  // namespace
+}  // namespace mocap::viz
