@@ -54,12 +54,14 @@ const motion::Skeleton& source_skeleton(const posedb::Database& db, std::uint32_
   return db.clips()[db.frames()[frame].clip].skeleton;
 }
 
+// The structure decides, not the names: the cgspeed 2008 release names two finger joints
+// LFingers/RFingers where the 2010 one says LeftHandIndex1/RightHandIndex1, in the same tree.
 bool same_hierarchy(const motion::Skeleton& a, const motion::Skeleton& b) {
   if (a.joint_count() != b.joint_count()) return false;
   for (int j = 0; j < a.joint_count(); ++j) {
     const motion::SkeletonJoint& x = a.joints[j];
     const motion::SkeletonJoint& y = b.joints[j];
-    if (x.name != y.name || x.parent != y.parent || x.end_site != y.end_site ||
+    if (x.parent != y.parent || x.end_site != y.end_site ||
         x.channels != y.channels) {
       return false;
     }

@@ -30,8 +30,8 @@ std::optional<DatabasePose> database_pose_of(const posedb::Database& db, const P
 // joint positions only.
 const motion::Skeleton& source_skeleton(const posedb::Database& db, std::uint32_t frame);
 
-// True when values for one skeleton are values for the other: same joints in the same order, with
-// the same names, parents and channel lists (offsets, i.e. bone lengths, may differ).
+// True when values for one skeleton are values for the other: the same tree (parents, End Sites)
+// with the same channel lists; names and offsets (bone lengths) may differ.
 bool same_hierarchy(const motion::Skeleton& a, const motion::Skeleton& b);
 
 // Writes database poses as channel values for one skeleton (the first clip's, when a person's

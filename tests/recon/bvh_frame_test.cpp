@@ -138,6 +138,12 @@ TEST(BvhFrame, HierarchiesCompareByJointsNotBoneLengths) {
   longer.joints[3].offset *= 1.2f;
   EXPECT_TRUE(same_hierarchy(db.clips()[0].skeleton, db.clips()[1].skeleton));
   EXPECT_TRUE(same_hierarchy(db.clips()[0].skeleton, longer));
+  motion::Skeleton renamed = db.clips()[0].skeleton;  // the 2008 release's finger names
+  renamed.joints[renamed.find("LeftHandIndex1")].name = "LFingers";
+  EXPECT_TRUE(same_hierarchy(db.clips()[0].skeleton, renamed));
+  motion::Skeleton other_channels = db.clips()[0].skeleton;
+  other_channels.joints[5].channels.pop_back();
+  EXPECT_FALSE(same_hierarchy(db.clips()[0].skeleton, other_channels));
   EXPECT_FALSE(same_hierarchy(db.clips()[0].skeleton, db.clips()[2].skeleton));
   BvhFrameMaker maker(db.clips()[0].skeleton, "08_01");
   std::vector<float> values;
