@@ -61,8 +61,7 @@ bool same_hierarchy(const motion::Skeleton& a, const motion::Skeleton& b) {
   for (int j = 0; j < a.joint_count(); ++j) {
     const motion::SkeletonJoint& x = a.joints[j];
     const motion::SkeletonJoint& y = b.joints[j];
-    if (x.parent != y.parent || x.end_site != y.end_site ||
-        x.channels != y.channels) {
+    if (x.parent != y.parent || x.end_site != y.end_site || x.channels != y.channels) {
       return false;
     }
   }
@@ -112,6 +111,34 @@ void BvhFrameMaker::channels(const posedb::Database& db, DatabasePose pose,
     if (skeleton.joints[j].parent < 0) pose_.translation[j] = shift;
   }
   values = motion::to_clip(pose_).values;
+}
+
+void BvhFrameMaker::enable_smoothing(const OneEuroParams& params) {
+  rotation_filters_.assign(static_cast<std::size_t>(pose_.skeleton.joint_count()),
+                           OneEuroFilterQuat(params));
+  height_filter_ = OneEuroFilter(params);
+}
+
+void BvhFrameMaker::channels(const posedb::Database& db, DatabasePose pose, double t_seconds,
+                             std::vector<float>& values) {
+  if (rotation_filters_.empty()) {
+    channels(db, pose, values);
+    return;
+  }
+  channels(db, pose, values);  // fills pose_ with this frame's rotations and root
+  smooth(t_seconds);
+  values = motion::to_clip(pose_).values;
+}
+
+void BvhFrameMaker::smooth(double t_seconds) {
+  for (int j = 0; j < pose_.skeleton.joint_count(); ++j) {
+    pose_.rotation[j] =
+        rotation_filters_[static_cast<std::size_t>(j)].filter(t_seconds, pose_.rotation[j]);
+    if (pose_.skeleton.joints[j].parent < 0) {
+      glm::vec3& root = pose_.translation[j];
+      root.y = static_cast<float>(height_filter_.filter(t_seconds, root.y));
+    }
+  }
 }
 
 }  // namespace mocap::recon

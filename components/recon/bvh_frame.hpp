@@ -12,6 +12,7 @@
 #include "motion/body_mapping.hpp"
 #include "motion/pose_sequence.hpp"
 #include "posedb/database.hpp"
+#include "recon/one_euro_filter.hpp"
 
 namespace mocap::recon {
 
@@ -55,7 +56,17 @@ class BvhFrameMaker {
   // std::invalid_argument otherwise.
   void channels(const posedb::Database& db, DatabasePose pose, std::vector<float>& values);
 
+  // From now on, channels() smooths every joint's rotation and the root height over successive
+  // calls with the 1-Euro filter (on the rotation group), `t_seconds` being the frame's time.
+  // Switching between mocap clips otherwise shows as jumps in the file.
+  void enable_smoothing(const OneEuroParams& params);
+  void channels(const posedb::Database& db, DatabasePose pose, double t_seconds,
+                std::vector<float>& values);
+
  private:
+  void smooth(double t_seconds);
+  std::vector<OneEuroFilterQuat> rotation_filters_;  // empty: no smoothing
+  OneEuroFilter height_filter_;
   motion::PoseSequence pose_;  // one frame, reused
   motion::BodyMapping mapping_;
   motion::GlobalPose global_;

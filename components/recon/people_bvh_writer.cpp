@@ -59,13 +59,18 @@ void PeopleBvhWriter::start(const Person3D& person, std::int64_t frame) {
   }
   keep_open_files_bounded(person.id);
   BvhFrameMaker maker(skeleton, db_.clips()[db_.frames()[pose->frame].clip].source);
+  if (options_.smooth_rotations) maker.enable_smoothing(options_.smoothing);
   std::vector<float> values;
-  maker.channels(db_, *pose, values);
+  maker.channels(db_, *pose, seconds(frame), values);
   motion::BvhStreamWriter file(path_for(person.id), skeleton, 1.0 / options_.fps);
   file.append(values);
   tracks_.emplace(person.id, Track{std::move(file), std::move(maker), std::move(values), frame});
   ++summary_.files;
   ++summary_.frames;
+}
+
+double PeopleBvhWriter::seconds(std::int64_t frame) const {
+  return static_cast<double>(frame) / options_.fps;
 }
 
 void PeopleBvhWriter::append(Track& track, const Person3D& person, std::int64_t frame) {
@@ -82,7 +87,7 @@ void PeopleBvhWriter::append(Track& track, const Person3D& person, std::int64_t 
   } else if (!same_hierarchy(source_skeleton(db_, pose->frame), track.maker.skeleton())) {
     ++summary_.skeleton_mismatch;
   } else {
-    track.maker.channels(db_, *pose, track.values);
+    track.maker.channels(db_, *pose, seconds(frame), track.values);
   }
   track.file.append(track.values);
   ++summary_.frames;

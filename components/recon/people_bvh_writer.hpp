@@ -25,6 +25,10 @@ struct PeopleBvhOptions {
   std::string prefix = "person_";  // file name before the id
   double fps = 30.0;               // the input frame rate, written as the frame time
   int max_open_files = 64;         // more people than this: the longest-unseen file is suspended
+  // The database's rotations change abruptly where the chosen motion jumps between clips: the
+  // 1-Euro filter (on the rotation group, per joint) smooths them, as the paper smooths its motion.
+  bool smooth_rotations = true;
+  OneEuroParams smoothing;  // the paper's beta 0.4, fc_min 1 Hz
 };
 
 struct PeopleBvhSummary {
@@ -60,6 +64,7 @@ class PeopleBvhWriter {
     std::int64_t last_frame = 0;
   };
 
+  double seconds(std::int64_t frame) const;
   void start(const Person3D& person, std::int64_t frame);
   void append(Track& track, const Person3D& person, std::int64_t frame);
   void keep_open_files_bounded(int arriving_id);

@@ -151,7 +151,45 @@ TEST(BvhFrame, HierarchiesCompareByJointsNotBoneLengths) {
   EXPECT_THROW(BvhFrameMaker(motion::Skeleton{}, "positions only"), InputError);
 }
 
+// Smoothing keeps a still pose as it is and softens a pose that jumps back and forth.
+TEST(BvhFrame, SmoothingHoldsStillPosesAndDampsJumps) {
+  MOCAP_REQUIRE_SMALL_DATABASE(path);
+  const posedb::Database db = posedb::Database::open(path);
+  const std::uint32_t a = db.clips()[0].first_frame + 5, b = db.clips()[0].first_frame + 25;
+  BvhFrameMaker plain(db.clips()[0].skeleton, "08_01"), smooth(db.clips()[0].skeleton, "08_01");
+  smooth.enable_smoothing(OneEuroParams{});
+  std::vector<float> expected, got;
+  plain.channels(db, {a, 3}, expected);
+  for (int t = 0; t < 30; ++t) smooth.channels(db, {a, 3}, t / 30.0, got);
+  for (std::size_t c = 0; c < expected.size(); ++c) EXPECT_NEAR(got[c], expected[c], 1e-2) << c;
+  // Alternating between two poses: the smoothed channels move less than the raw ones.
+  std::vector<float> raw_a, raw_b, previous = got;
+  plain.channels(db, {b, 3}, raw_b);
+  raw_a = expected;
+  double raw_motion = 0, smooth_motion = 0;
+  for (int t = 30; t < 60; ++t) {
+    smooth.channels(db, {t % 2 ? b : a, 3}, t / 30.0, got);
+    for (std::size_t c = 3; c < got.size();
+         ++c) {  // rotations (the first three are the root position)
+      smooth_motion += std::abs(got[c] - previous[c]);
+      raw_motion += std::abs(raw_b[c] - raw_a[c]);
+    }
+    previous = got;
+  }
+  EXPECT_LT(smooth_motion, 0.5 * raw_motion);
+}
+
 // --- the per-person file writer
+
+PeopleBvhOptions writer_options(std::string dir, std::string prefix, double fps,
+                                int max_open_files) {
+  PeopleBvhOptions options;
+  options.dir = std::move(dir);
+  options.prefix = std::move(prefix);
+  options.fps = fps;
+  options.max_open_files = max_open_files;
+  return options;
+}
 
 Person3D person_at(const posedb::Database& db, int id, std::uint32_t clip, std::uint32_t offset,
                    int view = 0) {
@@ -177,7 +215,7 @@ TEST(PeopleBvhWriter, OneFilePerIdHeldOverGapsAndOverOtherSkeletons) {
   MOCAP_REQUIRE_SMALL_DATABASE(path);
   const posedb::Database db = posedb::Database::open(path);
   test::TempDir dir;
-  PeopleBvhWriter writer(db, {(dir.path() / "out").string(), "p", 25.0, 64});
+  PeopleBvhWriter writer(db, writer_options((dir.path() / "out").string(), "p", 25.0, 64));
   // Person 1 in frames 0-1, missing in 2-3, back in 4 with a Bandai pose (other skeleton), then
   // a CMU pose from the other CMU clip in 5. Person 2 only in frame 3. Untracked people ignored.
   writer.write(frame_of(0, {person_at(db, 1, 0, 0), person_at(db, -1, 0, 3)}));
@@ -212,7 +250,7 @@ TEST(PeopleBvhWriter, ManyPeopleStayUnderTheOpenFileLimit) {
     return std::distance(std::filesystem::directory_iterator("/proc/self/fd"), {});
   };
   const auto open_before = open_files();
-  PeopleBvhWriter writer(db, {dir.path().string(), "person_", 30.0, 3});
+  PeopleBvhWriter writer(db, writer_options(dir.path().string(), "person_", 30.0, 3));
   for (std::int64_t f = 0; f < 20; ++f) {
     std::vector<Person3D> people;
     for (int id = 0; id < 8; ++id) {
@@ -237,7 +275,7 @@ TEST(PeopleBvhWriter, FolderThatCannotBeMadeIsNamed) {
   std::ofstream(dir.file("file")) << "x";
   const std::string bad = dir.file("file") + "/sub";
   try {
-    PeopleBvhWriter writer(db, {bad, "p", 30.0, 4});
+    PeopleBvhWriter writer(db, writer_options(bad, "p", 30.0, 4));
     ADD_FAILURE() << "no error";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find(bad), std::string::npos) << e.what();

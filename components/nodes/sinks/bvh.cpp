@@ -22,6 +22,10 @@ class BvhSink : public Node {
     c.required_param<std::string>("dir", "output folder (created when missing)");
     c.required_param<std::string>("db", "the pose database the people were matched against");
     c.param<std::string>("prefix", "person_", "file name before the person id");
+    c.param<bool>("smooth", true, "smooth the joint rotations with the 1-Euro filter");
+    c.param<double>("beta", 0.4, "1-Euro cutoff slope for the rotations", {0.0, 100.0});
+    c.param<double>("min_cutoff", 1.0, "1-Euro cutoff at rest (Hz) for the rotations",
+                    {0.001, 1000.0});
     c.param<double>("fps", 30.0, "input frame rate, written as the BVH frame time",
                     {0.001, 10000.0});
   }
@@ -32,6 +36,9 @@ class BvhSink : public Node {
     options.dir = ctx.param<std::string>("dir");
     options.prefix = ctx.param<std::string>("prefix");
     options.fps = ctx.param<double>("fps");
+    options.smooth_rotations = ctx.param<bool>("smooth");
+    options.smoothing.beta = ctx.param<double>("beta");
+    options.smoothing.min_cutoff = ctx.param<double>("min_cutoff");
     writer_ = std::make_unique<recon::PeopleBvhWriter>(*db_, std::move(options));
   }
 
