@@ -17,6 +17,7 @@
 #include "posedb/cluster_search.hpp"
 #include "posedb/database.hpp"
 #include "posedb/exact_search.hpp"
+#include "posedb/flann_search.hpp"
 #include "progress_bar.hpp"
 
 namespace mocap::cli {
@@ -260,8 +261,11 @@ int query(int argc, char** argv) {
       .option("pose-file", "FILE", "the pose, from a file")
       .option("self", "N", "query with the database's own projection number N")
       .option("k", "N", "neighbours to return", "10")
-      .option("method", "NAME", "exact or clusters", "clusters")
-      .option("probe", "N", "clusters to scan (method clusters)", "8")
+      .option("method", "NAME",
+              "clusters (the database's own index), exact, or flann (kd-forest built now)",
+              "clusters")
+      .option("probe", "N", "clusters to scan (method clusters)", "16")
+      .option("checks", "N", "leaves to examine (method flann)", "128")
       .flag("json", "print JSON lines");
   int code = 0;
   if (!args.parse(argc, argv, code)) return code;
@@ -303,11 +307,23 @@ int query(int argc, char** argv) {
     index = std::make_unique<posedb::ClusterSearch>(db.projections(), db.centroids(),
                                                     db.cluster_begin(),
                                                     static_cast<int>(args.integer("probe")));
+  } else if (args.get("method") == "flann") {
+    posedb::FlannOptions flann;
+    flann.checks = static_cast<int>(args.integer("checks"));
+    index = std::make_unique<posedb::FlannSearch>(db.projections(), flann);
   } else {
-    throw InputError("--method", "expected exact or clusters, got '" + args.get("method") + "'");
+    throw InputError("--method",
+                     "expected clusters, exact or flann, got '" + args.get("method") + "'");
+  }
+  const bool partial =
+      std::any_of(weights.begin(), weights.end(), [](float w) { return w == 0.0f; });
+  if (partial && !index->supports_weights()) {
+    throw InputError(
+        "--method",
+        index->name() + " cannot leave missing joints out of the distance: use clusters or exact");
   }
   std::vector<posedb::Neighbor> found;
-  index->search(query.data(), weights.data(),
+  index->search(query.data(), index->supports_weights() ? weights.data() : nullptr,
                 static_cast<int>(std::clamp(args.integer("k"), 1L, 10000L)), found);
   for (size_t r = 0; r < found.size(); ++r) {
     const auto& rec = db.projection_records()[found[r].index];
