@@ -111,9 +111,14 @@ std::vector<HumanEvaSequence> humaneva_validation_sequences(const he::Dataset& d
             throw InputError(std::string(he::kPositions2dFile),
                              "no 2D for " + chunk->subject + " " + chunk->key);
           const he::Camera& camera = subject_cameras->second[c];
-          out.push_back({chunk->subject, std::string(action.label), chunk->key, camera.id,
+          out.push_back({chunk->subject,
+                         std::string(action.label),
+                         chunk->key,
+                         camera.id,
                          input_2d(chunk->positions_2d[c], fps),
-                         truth_in_camera(chunk->positions_3d, camera, fps)});
+                         truth_in_camera(chunk->positions_3d, camera, fps),
+                         {static_cast<float>(camera.fx), static_cast<float>(camera.fy),
+                          static_cast<float>(camera.cx), static_cast<float>(camera.cy)}});
         }
       }
     }

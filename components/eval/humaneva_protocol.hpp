@@ -63,6 +63,7 @@ struct HumanEvaSequence {
   std::string camera;                 // "C1"
   std::vector<recon::BodyXyc> input;  // ground-truth 2D, pixels, confidence 1, no noise
   std::vector<Body> truth_camera;     // camera frame (x right, y down, z forward), metres
+  recon::Pinhole intrinsics;          // the camera's (approximate, fitted) pinhole
 };
 
 // Every Validate chunk of the evaluated subjects and actions through every camera, resampled

@@ -109,6 +109,16 @@ std::vector<Pose3D> reconstruct_sequence(Matcher& matcher, const FrameBones& bon
       poses[t] = pose_in_camera(db, candidates[t][pick]);
     }
   }
+  if (options.camera.valid()) {
+    for (std::size_t t = 0; t < frames.size(); ++t) {
+      if (!poses[t].valid) continue;
+      const glm::vec2 root(frames[t][3 * index(Joint::root)],
+                           frames[t][3 * index(Joint::root) + 1]);
+      const glm::quat turn = ray_alignment(options.camera, root);
+      for (auto& joint : poses[t].joints) joint = turn * joint;
+      poses[t].body_to_camera = turn * poses[t].body_to_camera;
+    }
+  }
   smooth_sequence(poses, options);
   return poses;
 }

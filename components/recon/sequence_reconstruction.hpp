@@ -14,6 +14,7 @@
 
 #include "recon/matcher.hpp"
 #include "recon/one_euro_filter.hpp"
+#include "recon/ray_alignment.hpp"
 #include "recon/temporal_selector.hpp"
 
 namespace mocap::recon {
@@ -33,6 +34,8 @@ struct SequenceOptions {
   int sg_order = 3;
   int sg_window = 11;
   double fps = 24.0;
+  // When valid, every pose is turned onto the ray through its root's pixel (ray_alignment.hpp).
+  Pinhole camera;
 };
 
 using BodyXyc = std::array<float, kBodyJoints * 3>;  // 15 joints (x, y, confidence), image pixels

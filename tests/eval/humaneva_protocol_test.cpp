@@ -42,8 +42,8 @@ TEST(HumanEvaProtocol, TableMeansCellsAndSumsFrames) {
   a.pa_mpjpe_sum = 20;  // 10 mm
   b.frames = b.valid = 6;
   b.pa_mpjpe_sum = 180;  // 30 mm
-  table.add({"S1", "Walk", "", "C1", {}, {}}, a);
-  table.add({"S2", "Box", "", "C1", {}, {}}, b);
+  table.add({"S1", "Walk", "", "C1", {}, {}, {}}, a);
+  table.add({"S2", "Box", "", "C1", {}, {}, {}}, b);
   EXPECT_DOUBLE_EQ(table.cell("S1", "Walk").pa_mpjpe(), 10.0);
   EXPECT_DOUBLE_EQ(table.mean_cell_pa_mpjpe(), 20.0);  // cells count once each
   EXPECT_DOUBLE_EQ(table.all().pa_mpjpe(), 25.0);      // every frame counts once

@@ -59,8 +59,14 @@ std::vector<eval::Scores> run_jobs(const std::vector<Config>& configs,
                                  j.condition;  // same input for every config
       const auto rendered =
           eval::render(truth[j.sequence], cameras[j.camera], {}, conditions[j.condition], seed);
+      recon::SequenceOptions options = configs[j.config].sequence;
+      if (configs[j.config].align_to_ray) {
+        const eval::Image image;
+        options.camera =
+            recon::Pinhole::from_fov(image.width, image.height, image.horizontal_fov_deg);
+      }
       const auto poses = recon::reconstruct_sequence(*matchers[j.config], *bones[j.config],
-                                                     rendered.input, configs[j.config].sequence);
+                                                     rendered.input, options);
       results[i] = eval::score(poses, rendered.truth_camera);
       std::lock_guard lock(progress);
       bar.update("evaluate", static_cast<double>(++done) / static_cast<double>(jobs.size()));

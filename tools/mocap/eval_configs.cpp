@@ -29,22 +29,31 @@ std::vector<Config> make_configs(const posedb::Database& full, const posedb::Dat
   Config greedy{"greedy", "all views, greedy w = 4, no smoothing", &full, {}, base};
   greedy.sequence.selection = recon::Selection::greedy;
   configs.push_back(greedy);
-  Config path_sg{"full: path + SG",
-                 "all views, Viterbi path over candidates, Savitzky-Golay (3, 11)",
+  Config path_sg{"path + SG, no ray",
+                 "all views, Viterbi path over candidates, Savitzky-Golay (3, 11), pose as the "
+                 "database camera sees it",
                  &full,
                  {},
                  base};
   path_sg.sequence.selection = recon::Selection::path;
   path_sg.sequence.smoothing = recon::Smoothing::savitzky_golay;
   configs.push_back(path_sg);
-  Config path_euro{"full live: path + 1-Euro",
-                   "all views, Viterbi path, 1-Euro (beta 0.4, fc_min 1)",
-                   &full,
-                   {},
-                   base};
-  path_euro.sequence.selection = recon::Selection::path;
-  path_euro.sequence.smoothing = recon::Smoothing::one_euro;
-  configs.push_back(path_euro);
+  Config full_offline = path_sg;
+  full_offline.name = "full: path + SG";
+  full_offline.description =
+      "all views, Viterbi path, Savitzky-Golay (3, 11), pose turned onto the root's ray";
+  full_offline.align_to_ray = true;
+  configs.push_back(full_offline);
+  Config full_live{
+      "full live: path + 1-Euro",
+      "all views, Viterbi path, 1-Euro (beta 0.4, fc_min 1), pose turned onto the root's ray",
+      &full,
+      {},
+      base};
+  full_live.sequence.selection = recon::Selection::path;
+  full_live.sequence.smoothing = recon::Smoothing::one_euro;
+  full_live.align_to_ray = true;
+  configs.push_back(full_live);
   return configs;
 }
 

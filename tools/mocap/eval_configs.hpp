@@ -22,6 +22,8 @@ struct Config {
   const posedb::Database* db;
   recon::MatchOptions match;
   recon::SequenceOptions sequence;
+  // Turn every pose onto the ray through its root pixel, with the protocol's true intrinsics.
+  bool align_to_ray = false;
 };
 
 // The paper's configuration on `paper` (its yaw-only database), then per-frame nearest

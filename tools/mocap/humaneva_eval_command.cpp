@@ -131,8 +131,10 @@ std::vector<eval::Scores> run_jobs(const std::vector<std::vector<Config>>& confi
         const Config& config = configs[job.family][job.config];
         recon::Matcher matcher(*config.db, config.match);
         const std::uint64_t seed = 1000003ull * job.sequence + job.condition;  // same for all
+        recon::SequenceOptions options = config.sequence;
+        if (config.align_to_ray) options.camera = sequences[job.sequence].intrinsics;
         results[i] = eval::evaluate_sequence(matcher, *bones.at(config.db), sequences[job.sequence],
-                                             conditions[job.condition], config.sequence, seed);
+                                             conditions[job.condition], options, seed);
       },
       [&](std::size_t done) {
         bar.update("evaluate", static_cast<double>(done) / static_cast<double>(jobs.size()));

@@ -1,0 +1,26 @@
+#pragma once
+// Every database camera looks straight at the person's root; a real camera sees the person
+// somewhere off its optical axis, along the ray through the root's pixel. A pose taken from the
+// database is therefore turned from the "looking at the root" frame into the real camera's frame,
+// or every joint is off by the angle between the optical axis and that ray (7-25° for a person
+// in a corner of a wide view).
+
+#include <glm/gtc/quaternion.hpp>
+#include <glm/vec2.hpp>
+
+namespace mocap::recon {
+
+struct Pinhole {
+  float fx = 0, fy = 0, cx = 0, cy = 0;  // pixels
+  bool valid() const { return fx > 0 && fy > 0; }
+  // A camera of `width` x `height` pixels and horizontal field of view `hfov_deg`, square pixels,
+  // principal point in the centre: the assumption when no calibration is given.
+  static Pinhole from_fov(int width, int height, float hfov_deg);
+};
+
+// The rotation taking a pose expressed in a camera that looks at the root (x horizontal) into the
+// frame of `camera`, which sees the root at `root_pixel`. Assumes the camera has no roll (its x
+// axis horizontal), as the database's cameras.
+glm::quat ray_alignment(const Pinhole& camera, glm::vec2 root_pixel);
+
+}  // namespace mocap::recon
