@@ -43,7 +43,8 @@ if [[ ! -d "$input" ]]; then
   echo "demo.sh: no keypoints to reconstruct at $input (give a folder of OpenPose JSON with --input)" >&2
   exit 1
 fi
-"$mocap" reconstruct "$input" --db "$db" --out "$out" --quiet
+# The badminton keypoints come from a 1920x1080, 25 fps video (../shared/data/eval/openpose_json/README.md).
+"$mocap" reconstruct "$input" --db "$db" --out "$out" --fps 25 --image-size 1920x1080 --quiet
 echo
 echo "Open $out/overlay.mp4 to watch the input beside the 3D result; $out/person_<id>.bvh import into"
 echo "Blender, MotionBuilder or Maya; $out/poses.jsonl has every frame's 15 joints per person."

@@ -43,6 +43,12 @@ Pose3D pose_in_camera(const posedb::Database& db, const Candidate& chosen) {
   return pose;
 }
 
+void turn_onto_ray(Pose3D& pose, const Pinhole& camera, glm::vec2 root_pixel) {
+  const glm::quat turn = ray_alignment(camera, root_pixel);
+  for (auto& joint : pose.joints) joint = turn * joint;
+  pose.body_to_camera = turn * pose.body_to_camera;
+}
+
 namespace {
 
 template <class Filter>

@@ -56,6 +56,9 @@ std::vector<Pose3D> reconstruct_sequence(Matcher& matcher, const FrameBones& bon
                                          std::span<const BodyXyc> frames,
                                          const SequenceOptions& options);
 
+// Turns a database pose onto the ray through its root pixel as `camera` sees it (ray_alignment).
+void turn_onto_ray(Pose3D& pose, const Pinhole& camera, glm::vec2 root_pixel);
+
 // Smooths the joints of valid poses in place (each run of consecutive valid frames on its own).
 void smooth_sequence(std::vector<Pose3D>& poses, const SequenceOptions& options);
 

@@ -62,6 +62,18 @@ void configure(graph::GraphSpec& spec, const Args& args, const fs::path& out) {
     set_param(spec, type, "db", args.get("db"));
   }
   set_param(spec, "recon.temporal_selector", "mode", args.get("mode"));
+  if (args.has("image-size")) {
+    const std::string size = args.get("image-size");
+    const auto x = size.find('x');
+    if (x == std::string::npos || x == 0 || x + 1 == size.size() ||
+        size.find_first_not_of("0123456789x") != std::string::npos) {
+      throw InputError("--image-size",
+                       "expected WIDTHxHEIGHT in pixels, e.g. 1920x1080, got '" + size + "'");
+    }
+    set_param(spec, "recon.temporal_selector", "image_width", size.substr(0, x));
+    set_param(spec, "recon.temporal_selector", "image_height", size.substr(x + 1));
+    set_param(spec, "recon.temporal_selector", "hfov_deg", args.get("hfov"));
+  }
   set_param(spec, "sink.jsonl", "path", (out / "poses.jsonl").string());
   set_param(spec, "sink.bvh", "dir", out.string());
   set_param(spec, "sink.overlay", "video", (out / "overlay.mp4").string());
@@ -114,6 +126,10 @@ int reconstruct_command(int argc, char** argv) {
       .option("out", "DIR", "output folder (created)")
       .option("db", "FILE", "pose database", default_database())
       .option("fps", "N", "frame rate of the keypoints' video", "30")
+      .option("image-size", "WxH",
+              "size of the images the keypoints came from; turns each pose onto its camera ray "
+              "(off when absent)")
+      .option("hfov", "DEG", "horizontal field of view assumed with --image-size", "60")
       .option("mode", "NAME",
               "temporal selection: path (Viterbi, lag 8), greedy (the paper) or nearest", "path")
       .option("graph", "FILE", "graph to run",

@@ -45,6 +45,14 @@ class TemporalSelectorNode : public Node {
     c.param<double>("data_weight", 50.0, "path: weight of the 2D match distance", {0.0, 1e6});
     c.param<int>("max_missed", 10, "frames a person may be missing before its state is dropped",
                  {0, 10000});
+    c.param<int>(
+        "image_width", 0,
+        "input image width in pixels; with the height, turns each pose onto the ray through "
+        "its root pixel (0: off)",
+        {0, 100000});
+    c.param<int>("image_height", 0, "input image height in pixels", {0, 100000});
+    c.param<double>("hfov_deg", 60.0, "horizontal field of view assumed for the camera",
+                    {1.0, 179.0});
   }
 
   void open(Context& ctx) override {
@@ -60,14 +68,19 @@ class TemporalSelectorNode : public Node {
     path_.data_weight = ctx.param<float>("data_weight");
     lag_ = mode_ == "path" ? ctx.param<int>("lag") : 0;
     max_missed_ = ctx.param<int>("max_missed");
+    const int width = ctx.param<int>("image_width"), height = ctx.param<int>("image_height");
+    if (width > 0 && height > 0)
+      camera_ = recon::Pinhole::from_fov(width, height, ctx.param<float>("hfov_deg"));
   }
 
   void process(Context& ctx) override {
     const auto& in = ctx.input<PoseMatches>("in");
     const std::int64_t t = next_frame_++;
-    pending_.push_back({ctx.header(), {}});
+    pending_.push_back({ctx.header(), {}, {}});
     for (const PersonMatch& person : in.people) {
       if (person.id < 0) continue;  // untracked: no history to choose with
+      const Keypoint2D& root = person.body[index(Joint::root)];
+      pending_.back().root_pixel[person.id] = {root.x, root.y};
       Track& track = tracks_[person.id];
       if (!track.path && !track.greedy) start(track, t);
       track.last_seen = t;
@@ -105,6 +118,7 @@ class TemporalSelectorNode : public Node {
   struct PendingFrame {
     Header header;
     std::vector<Person3D> people;
+    std::map<int, glm::vec2> root_pixel;  // of each person in this frame's input
   };
 
   void start(Track& track, std::int64_t t) {
@@ -145,7 +159,13 @@ class TemporalSelectorNode : public Node {
   void add(int id, std::int64_t frame, const recon::Pose3D& pose) {
     const std::int64_t slot = frame - first_pending_;
     if (slot < 0 || slot >= static_cast<std::int64_t>(pending_.size())) return;  // already sent
-    pending_[static_cast<std::size_t>(slot)].people.push_back(to_person(id, pose, *db_));
+    PendingFrame& pending = pending_[static_cast<std::size_t>(slot)];
+    recon::Pose3D turned = pose;
+    if (const auto root = pending.root_pixel.find(id);
+        camera_.valid() && root != pending.root_pixel.end()) {
+      recon::turn_onto_ray(turned, camera_, root->second);
+    }
+    pending.people.push_back(to_person(id, turned, *db_));
   }
 
   // Sends every pending frame up to and including `last`, in order.
@@ -169,6 +189,7 @@ class TemporalSelectorNode : public Node {
   recon::PathOptions path_;
   int lag_ = 0;
   int max_missed_ = 10;
+  recon::Pinhole camera_;  // invalid: poses stay as the database cameras see them
   std::map<int, Track> tracks_;
   std::deque<PendingFrame> pending_;
   std::int64_t next_frame_ = 0, first_pending_ = 0;
