@@ -156,4 +156,32 @@ long Args::integer(const std::string& name) const {
   return value;
 }
 
+int run_subcommand(std::string_view command, std::span<const Subcommand> subcommands, int argc,
+                   char** argv) {
+  std::ostringstream usage;
+  usage << "usage: mocap " << command << " ";
+  for (std::size_t i = 0; i < subcommands.size(); ++i)
+    usage << (i ? "|" : "") << subcommands[i].name;
+  usage << " ...\n\n";
+  for (const auto& s : subcommands) {
+    usage << "  " << s.name << std::string(s.name.size() < 10 ? 10 - s.name.size() : 1, ' ')
+          << s.summary << "\n";
+  }
+  usage << "\nRun 'mocap " << command << " SUBCOMMAND --help' for options.\n";
+  if (argc < 1) {
+    std::cerr << usage.str();
+    return 2;
+  }
+  const std::string_view name = argv[0];
+  for (const auto& s : subcommands) {
+    if (s.name == name) return s.run(argc - 1, argv + 1);
+  }
+  if (name == "--help" || name == "-h") {
+    std::cout << usage.str();
+    return 0;
+  }
+  std::cerr << "mocap " << command << ": unknown subcommand '" << name << "'\n\n" << usage.str();
+  return 2;
+}
+
 }  // namespace mocap::cli

@@ -4,7 +4,9 @@
 
 #include <map>
 #include <optional>
+#include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace mocap::cli {
@@ -50,5 +52,15 @@ class Args {
   std::map<std::string, std::vector<std::string>> values_;
   std::vector<std::string> positionals_;
 };
+
+// A command with subcommands (`mocap db build|info|query`): runs the one named by argv[0] with the
+// arguments after it; prints the usage for --help, no subcommand (exit 2) or an unknown one (2).
+struct Subcommand {
+  std::string_view name;
+  std::string_view summary;
+  int (*run)(int argc, char** argv);
+};
+int run_subcommand(std::string_view command, std::span<const Subcommand> subcommands, int argc,
+                   char** argv);
 
 }  // namespace mocap::cli

@@ -354,26 +354,12 @@ int query(int argc, char** argv) {
 }  // namespace
 
 int db_command(int argc, char** argv) {
-  const std::string usage =
-      "usage: mocap db build|info|query ...\n\n"
-      "  build   build a pose database from mocap files\n"
-      "  info    print what a database holds\n"
-      "  query   find the nearest projections of a 2D pose\n\n"
-      "Run 'mocap db SUBCOMMAND --help' for options.\n";
-  if (argc < 1) {
-    std::cerr << usage;
-    return 2;
-  }
-  const std::string sub = argv[0];
-  if (sub == "build") return build(argc - 1, argv + 1);
-  if (sub == "info") return info(argc - 1, argv + 1);
-  if (sub == "query") return query(argc - 1, argv + 1);
-  if (sub == "--help" || sub == "-h") {
-    std::cout << usage;
-    return 0;
-  }
-  std::cerr << "mocap db: unknown subcommand '" << sub << "'\n\n" << usage;
-  return 2;
+  static constexpr Subcommand kSubcommands[] = {
+      {"build", "build a pose database from mocap files", build},
+      {"info", "print what a database holds", info},
+      {"query", "find the nearest projections of a 2D pose", query},
+  };
+  return run_subcommand("db", kSubcommands, argc, argv);
 }
 
 }  // namespace mocap::cli

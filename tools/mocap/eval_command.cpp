@@ -191,24 +191,12 @@ int virtual_protocol(int argc, char** argv) {
 }  // namespace
 
 int eval_command(int argc, char** argv) {
-  const std::string usage =
-      "usage: mocap eval virtual|humaneva ...\n\n"
-      "  virtual    the paper's virtual-video protocol on held-out CMU subjects\n"
-      "  humaneva   HumanEva-I Validate from ground-truth 2D, CMU and HumanEva databases\n\n"
-      "Run 'mocap eval SUBCOMMAND --help' for options.\n";
-  if (argc < 1) {
-    std::cerr << usage;
-    return 2;
-  }
-  const std::string sub = argv[0];
-  if (sub == "virtual") return virtual_protocol(argc - 1, argv + 1);
-  if (sub == "humaneva") return humaneva_eval_command(argc - 1, argv + 1);
-  if (sub == "--help" || sub == "-h") {
-    std::cout << usage;
-    return 0;
-  }
-  std::cerr << "mocap eval: unknown subcommand '" << sub << "'\n\n" << usage;
-  return 2;
+  static constexpr Subcommand kSubcommands[] = {
+      {"virtual", "the paper's virtual-video protocol on held-out CMU subjects", virtual_protocol},
+      {"humaneva", "HumanEva-I Validate from ground-truth 2D, CMU and HumanEva databases",
+       humaneva_eval_command},
+  };
+  return run_subcommand("eval", kSubcommands, argc, argv);
 }
 
 }  // namespace mocap::cli
