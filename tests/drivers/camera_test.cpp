@@ -1,0 +1,171 @@
+// mocap_aravis against Aravis' own fake GigE Vision camera, run as a child process on loopback.
+// Skipped, saying why, when aravis-tools is not installed. Timings are checked loosely: the
+// machine is shared.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <thread>
+
+#include "camera.hpp"
+#include "fake_gv_camera.hpp"
+
+namespace mocap::aravis {
+namespace {
+
+using namespace std::chrono_literals;
+using test::FakeGvCamera;
+
+class FakeCameraTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    program_ = test::fake_camera_program();
+    if (!program_)
+      GTEST_SKIP() << test::kFakeCameraProgram << " not on PATH (package aravis-tools)";
+  }
+  std::unique_ptr<FakeGvCamera> start(int loss_per_thousand = 0) {
+    return std::make_unique<FakeGvCamera>(*program_, test::unique_serial("MOCAP"),
+                                          loss_per_thousand);
+  }
+  static CameraSettings mono8(const std::string& id, double fps) {
+    CameraSettings s;
+    s.id = id;
+    s.region = Region{0, 0, 512, 512};
+    s.frame_rate = fps;
+    s.pixel_format = "Mono8";
+    return s;
+  }
+  static std::vector<Frame> grab(Camera& camera, int n) {
+    std::vector<Frame> frames;
+    for (int i = 0; i < 4 * n && static_cast<int>(frames.size()) < n; ++i) {
+      if (auto f = camera.next(2s)) frames.push_back(std::move(*f));
+    }
+    return frames;
+  }
+  std::optional<std::string> program_;
+};
+
+// GigE Vision 1 block ids are 16 bits, counting 1..65535 and wrapping.
+bool follows(std::uint64_t previous, std::uint64_t id) {
+  return id == previous + 1 || (previous == 65535 && id <= 1);
+}
+
+TEST_F(FakeCameraTest, ListsTheFakeCamera) {
+  const auto camera = start();
+  const auto devices = list_devices();
+  const auto it = std::find_if(devices.begin(), devices.end(),
+                               [&](const DeviceInfo& d) { return d.serial == camera->serial(); });
+  ASSERT_NE(it, devices.end());
+  EXPECT_EQ(it->vendor, "Aravis");
+  EXPECT_EQ(it->model, "Fake");
+  EXPECT_EQ(it->address, "127.0.0.1");
+  EXPECT_EQ(it->protocol, "GigEVision");
+  EXPECT_FALSE(it->id.empty());
+}
+
+TEST_F(FakeCameraTest, GrabsMono8WithMonotonicTimestampsAndFrameIds) {
+  const auto fake = start();
+  Camera camera(mono8(fake->serial(), 50));
+  EXPECT_EQ(camera.pixel_format(), "Mono8");
+  EXPECT_EQ(camera.info().serial, fake->serial());
+  const auto frames = grab(camera, 10);
+  ASSERT_EQ(frames.size(), 10u);
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    EXPECT_EQ(frames[i].image.width(), 512);
+    EXPECT_EQ(frames[i].image.height(), 512);
+    EXPECT_EQ(frames[i].image.format(), PixelFormat::gray8);
+    EXPECT_GT(frames[i].capture_ns, 0);
+    if (i == 0) continue;
+    EXPECT_GT(frames[i].device_ns, frames[i - 1].device_ns);
+    EXPECT_GT(frames[i].capture_ns, frames[i - 1].capture_ns);
+    EXPECT_TRUE(follows(frames[i - 1].frame_id, frames[i].frame_id))
+        << frames[i - 1].frame_id << " then " << frames[i].frame_id;
+  }
+  // capture time is device time moved onto CLOCK_REALTIME: never after the frame arrived.
+  EXPECT_LE(frames.back().capture_ns, frames.back().system_ns);
+  EXPECT_EQ(camera.counters().delivered, 10u);
+}
+
+TEST_F(FakeCameraTest, BayerAndRgbArriveAsRgb8) {
+  const auto fake = start();
+  for (const std::string format : {"BayerRG8", "BayerGB8", "RGB8"}) {
+    CameraSettings s = mono8(fake->serial(), 30);
+    s.pixel_format = format;
+    s.region = Region{0, 0, 320, 240};
+    Camera camera(s);
+    EXPECT_EQ(camera.pixel_format(), format);
+    const auto frames = grab(camera, 2);
+    ASSERT_EQ(frames.size(), 2u) << format;
+    EXPECT_EQ(frames[0].image.format(), PixelFormat::rgb8) << format;
+    EXPECT_EQ(frames[0].image.width(), 320) << format;
+    EXPECT_EQ(frames[0].image.height(), 240) << format;
+  }
+}
+
+TEST_F(FakeCameraTest, AchievedRateFollowsTheSetting) {
+  const auto fake = start();
+  for (const double fps : {20.0, 80.0}) {
+    Camera camera(mono8(fake->serial(), fps));
+    EXPECT_NEAR(camera.frame_rate(), fps, 0.5);
+    const auto frames = grab(camera, 20);
+    ASSERT_EQ(frames.size(), 20u);
+    // The device clock paces the frames exactly; the host may fall behind on a busy machine, so
+    // only the device's spacing is checked closely.
+    const double device_rate =
+        19e9 / static_cast<double>(frames.back().device_ns - frames.front().device_ns);
+    EXPECT_NEAR(device_rate, fps, 0.2 * fps);
+  }
+}
+
+TEST_F(FakeCameraTest, PacketLossIsCountedAndNeverDelivered) {
+  const auto fake = start(/*loss_per_thousand=*/30);
+  Camera camera(mono8(fake->serial(), 50));
+  int delivered = 0;
+  const auto deadline = std::chrono::steady_clock::now() + 4s;
+  while (std::chrono::steady_clock::now() < deadline) {
+    if (const auto f = camera.next(500ms)) {
+      ++delivered;
+      EXPECT_EQ(f->image.size_bytes(), 512u * 512u);
+    }
+  }
+  const StreamCounters counters = camera.counters();
+  EXPECT_EQ(counters.delivered, static_cast<std::uint64_t>(delivered));
+  EXPECT_GT(counters.incomplete + counters.skipped_ids, 0u)
+      << "delivered " << delivered << " with 3% of the packets lost";
+}
+
+TEST_F(FakeCameraTest, AnUnknownCameraIsNamedInTheError) {
+  try {
+    Camera camera(mono8("no-such-camera-4711", 25));
+    FAIL() << "opened a camera that does not exist";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("no-such-camera-4711"), std::string::npos) << e.what();
+  }
+}
+
+TEST_F(FakeCameraTest, AnUnsupportedPixelFormatIsNamed) {
+  const auto fake = start();
+  CameraSettings s = mono8(fake->serial(), 25);
+  s.pixel_format = "Mono16";
+  try {
+    Camera camera(s);
+    FAIL() << "Mono16 accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("Mono16"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find(fake->serial()), std::string::npos) << e.what();
+  }
+}
+
+TEST_F(FakeCameraTest, ControlLostIsSeenWhenTheCameraDies) {
+  auto fake = start();
+  Camera camera(mono8(fake->serial(), 25));
+  ASSERT_TRUE(camera.next(2s));
+  fake->stop();
+  const auto deadline = std::chrono::steady_clock::now() + 30s;  // heartbeat: ~14 s
+  while (!camera.control_lost() && std::chrono::steady_clock::now() < deadline) camera.next(200ms);
+  EXPECT_TRUE(camera.control_lost());
+  EXPECT_FALSE(camera.next(100ms));
+}
+
+}  // namespace
+}  // namespace mocap::aravis
