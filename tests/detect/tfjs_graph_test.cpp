@@ -1,0 +1,139 @@
+// The TF.js graph-model loader on a tiny hand-written model (no download needed): float16
+// weights dequantised, the int32 input Cast dropped, _FusedConv2D split so that cv::dnn runs it,
+// and a clear error naming every operation it does not convert. Also its protobuf encoder.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <opencv2/dnn.hpp>
+
+#include "detect/protobuf_writer.hpp"
+#include "detect/tfjs_graph.hpp"
+#include "support/files.hpp"
+
+namespace mocap::detect {
+namespace {
+
+TEST(HalfToFloat, DecodesNormalSubnormalAndSpecialValues) {
+  EXPECT_EQ(half_to_float(0x3C00), 1.0f);
+  EXPECT_EQ(half_to_float(0xC000), -2.0f);
+  EXPECT_EQ(half_to_float(0x7BFF), 65504.0f);
+  EXPECT_EQ(half_to_float(0x0001), std::ldexp(1.0f, -24));
+  EXPECT_EQ(half_to_float(0x3555), 0.333251953125f);
+  EXPECT_EQ(half_to_float(0x8000), -0.0f);
+  EXPECT_TRUE(std::isinf(half_to_float(0x7C00)));
+  EXPECT_TRUE(std::isnan(half_to_float(0x7E00)));
+}
+
+TEST(ProtoMessage, EncodesTheWireFormat) {
+  ProtoMessage m;
+  m.add_varint(1, 300);
+  m.add_bytes(2, "ab");
+  m.add_float(3, 1.0f);
+  m.add_int64(4, -1);
+  const std::string want = std::string("\x08\xac\x02", 3) +
+                           "\x12\x02"
+                           "ab" +
+                           std::string("\x1d\x00\x00\x80\x3f", 5) + "\x20" +
+                           std::string(9, '\xff') + "\x01";
+  EXPECT_EQ(m.bytes(), want);
+}
+
+// input (int32 RGB) -> Cast -> _FusedConv2D 1×1, 3 -> 2 channels, [BiasAdd, Relu]; and two
+// post-processing nodes the loader refuses.
+constexpr const char* kTinyModel = R"({
+  "format": "graph-model",
+  "modelTopology": {"node": [
+    {"name": "w", "op": "Const", "attr": {"dtype": {"type": "DT_FLOAT"}}},
+    {"name": "b", "op": "Const", "attr": {"dtype": {"type": "DT_FLOAT"}}},
+    {"name": "k", "op": "Const", "attr": {"dtype": {"type": "DT_INT32"}}},
+    {"name": "input", "op": "Placeholder", "attr": {"dtype": {"type": "DT_INT32"},
+      "shape": {"shape": {"dim": [{"size": "1"}, {"size": "-1"}, {"size": "-1"}, {"size": "3"}]}}}},
+    {"name": "cast", "op": "Cast", "input": ["input"],
+     "attr": {"SrcT": {"type": "DT_INT32"}, "DstT": {"type": "DT_FLOAT"}}},
+    {"name": "conv", "op": "_FusedConv2D", "input": ["cast", "w", "b"], "attr": {
+      "T": {"type": "DT_FLOAT"}, "strides": {"list": {"i": ["1", "1", "1", "1"]}},
+      "dilations": {"list": {"i": ["1", "1", "1", "1"]}}, "padding": {"s": "U0FNRQ=="},
+      "data_format": {"s": "TkhXQw=="}, "num_args": {"i": "1"},
+      "fused_ops": {"list": {"s": ["Qmlhc0FkZA==", "UmVsdQ=="]}}}},
+    {"name": "topk", "op": "TopKV2", "input": ["conv", "k"]},
+    {"name": "pack", "op": "Pack", "input": ["conv"]}
+  ], "versions": {"producer": 808}},
+  "weightsManifest": [{"paths": ["tiny.bin"], "weights": [
+    {"name": "w", "shape": [1, 1, 3, 2], "dtype": "float32",
+     "quantization": {"dtype": "float16", "original_dtype": "float32"}},
+    {"name": "b", "shape": [2], "dtype": "float32",
+     "quantization": {"dtype": "float16", "original_dtype": "float32"}},
+    {"name": "k", "shape": [], "dtype": "int32"}
+  ]}]
+})";
+
+// Kernel HWIO: out0 = r + 0.5 g - b - 10, out1 = 2 b + 1 (float16: 1, 0, .5, 0, -1, 2; -10, 1).
+std::string tiny_weights() {
+  const std::vector<std::uint16_t> halves = {0x3C00, 0x0000, 0x3800, 0x0000,
+                                             0xBC00, 0x4000, 0xC900, 0x3C00};
+  std::string bytes(reinterpret_cast<const char*>(halves.data()), halves.size() * 2);
+  const std::int32_t k = 6;
+  bytes.append(reinterpret_cast<const char*>(&k), sizeof k);
+  return bytes;
+}
+
+struct TinyModel {
+  test::TempDir dir;
+  std::filesystem::path json = dir.path() / "tiny.json";
+  explicit TinyModel(const std::string& weights = tiny_weights()) {
+    std::ofstream(json) << kTinyModel;
+    std::ofstream(dir.path() / "tiny.bin", std::ios::binary) << weights;
+  }
+};
+
+TEST(TfjsGraph, FusedConvolutionRunsInCvDnnWithDequantisedWeights) {
+  const TinyModel model;
+  const std::vector<std::string> outputs = {"conv"};
+  const std::string graph = tfjs_to_graphdef(model.json, outputs);
+  cv::dnn::Net net = cv::dnn::readNetFromTensorflow(graph.data(), graph.size());
+  // NCHW 1×3×1×2: pixel 0 is RGB (20, 40, 10), pixel 1 is black.
+  const int shape[] = {1, 3, 1, 2};
+  cv::Mat blob(4, shape, CV_32F);
+  const float rgb[] = {20, 0, 40, 0, 10, 0};
+  std::copy(std::begin(rgb), std::end(rgb), blob.ptr<float>());
+  net.setInput(blob);
+  const cv::Mat out = net.forward("conv");
+  ASSERT_EQ(out.total(), 4u);
+  const float* o = out.ptr<float>();  // NCHW: channel 0 at both pixels, then channel 1
+  EXPECT_FLOAT_EQ(o[0], 20.0f);       // 20 + 20 - 10 - 10
+  EXPECT_FLOAT_EQ(o[1], 0.0f);        // ReLU of -10
+  EXPECT_FLOAT_EQ(o[2], 21.0f);
+  EXPECT_FLOAT_EQ(o[3], 1.0f);
+}
+
+TEST(TfjsGraph, NamesEveryUnsupportedOperation) {
+  const TinyModel model;
+  const std::vector<std::string> outputs = {"topk", "pack"};
+  try {
+    tfjs_to_graphdef(model.json, outputs);
+    FAIL() << "expected an error";
+  } catch (const std::runtime_error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("TopKV2 (node 'topk')"), std::string::npos) << what;
+    EXPECT_NE(what.find("Pack (node 'pack')"), std::string::npos) << what;
+    EXPECT_NE(what.find("tiny.json"), std::string::npos) << what;
+  }
+}
+
+TEST(TfjsGraph, RefusesUnknownOutputsAndShortWeights) {
+  const std::vector<std::string> missing = {"nothing"};
+  EXPECT_THROW(tfjs_to_graphdef(TinyModel().json, missing), std::runtime_error);
+  const std::vector<std::string> conv = {"conv"};
+  EXPECT_THROW(tfjs_to_graphdef(TinyModel(tiny_weights().substr(0, 6)).json, conv),
+               std::runtime_error);
+  EXPECT_THROW(tfjs_to_graphdef("/nonexistent/model.json", conv), std::runtime_error);
+}
+
+}  // namespace
+}  // namespace mocap::detect
