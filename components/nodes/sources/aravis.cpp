@@ -1,0 +1,133 @@
+// source.aravis: frames from a GigE Vision / USB3 Vision camera through Aravis (drivers/aravis).
+// A camera that stops answering ("control-lost") is reported and reopened, with the same
+// settings, whenever it comes back; the graph keeps running meanwhile.
+
+#include <cmath>
+#include <iostream>
+#include <optional>
+
+#include "camera.hpp"
+#include "graph/registry.hpp"
+
+namespace mocap::nodes {
+using namespace mocap::graph;
+
+class AravisSource : public Node {
+ public:
+  static void contract(Contract& c) {
+    c.doc("Frames from a GigE Vision / USB3 Vision camera (Aravis); reconnects when it returns");
+    c.output<VideoFrame>("frames");
+    c.param<std::string>("id", "", "camera id, serial or address (empty: the first found)");
+    c.param<double>("fps", 0.0, "frame rate (0: the camera's setting)", {0, 10000});
+    c.param<std::int64_t>("x", 0, "region left (pixels)", {0, 65535});
+    c.param<std::int64_t>("y", 0, "region top (pixels)", {0, 65535});
+    c.param<std::int64_t>("width", 0, "region width (0: the camera's setting)", {0, 65535});
+    c.param<std::int64_t>("height", 0, "region height (0: the camera's setting)", {0, 65535});
+    c.param<double>("exposure_us", 0.0, "exposure time in us (0: the camera's)", {0, 1e8});
+    c.param<double>("gain", -1.0, "gain (negative: the camera's)", {-1, 1000});
+    c.param<std::string>("pixel_format", "", "Mono8, BayerRG8, RGB8, ... (empty: the camera's)");
+    c.param<std::int64_t>("buffers", 0, "stream buffers (0: half a second of frames)", {0, 1024});
+    c.param<std::int64_t>("count", 0, "frames before end of stream (0: until stopped)", {0, 1e12});
+    c.param<std::int64_t>("camera", 0, "camera id in the messages", {0, 1000});
+  }
+
+  void open(Context& ctx) override {
+    settings_ = settings_from(ctx);
+    count_ = ctx.param<std::uint64_t>("count");
+    camera_id_ = ctx.param<int>("camera");
+    camera_.emplace(settings_);  // throws naming the camera: the graph fails to start
+    report_open(ctx, "streaming from");
+  }
+
+  void process(Context& ctx) override {
+    if (count_ != 0 && seq_ >= count_) return ctx.finish();
+    if (!camera_ && !reconnect(ctx)) return;
+    // Bounded, so that a stop request is seen within a fifth of a second.
+    auto frame = camera_->next(std::chrono::milliseconds(200));
+    account_drops(ctx);
+    if (camera_->control_lost()) return lose(ctx);
+    if (frame) send(ctx, std::move(*frame));
+  }
+
+  void close(Context& ctx) override {
+    if (camera_) account_drops(ctx);
+    std::cerr << ctx.node_name() << ": " << seq_ << " frames, " << incomplete_ << " incomplete, "
+              << skipped_ << " lost, " << reconnects_ << " reconnects\n";
+  }
+
+ private:
+  static aravis::CameraSettings settings_from(Context& ctx) {
+    aravis::CameraSettings s;
+    s.id = ctx.param<std::string>("id");
+    s.frame_rate = ctx.param<double>("fps");
+    const int width = ctx.param<int>("width"), height = ctx.param<int>("height");
+    if (width > 0 && height > 0)
+      s.region = aravis::Region{ctx.param<int>("x"), ctx.param<int>("y"), width, height};
+    s.exposure_us = ctx.param<double>("exposure_us");
+    if (const double gain = ctx.param<double>("gain"); gain >= 0) s.gain = gain;
+    s.pixel_format = ctx.param<std::string>("pixel_format");
+    s.buffers = ctx.param<int>("buffers");
+    return s;
+  }
+
+  void report_open(Context& ctx, const char* what) const {
+    const aravis::Region r = camera_->region();
+    std::cerr << ctx.node_name() << ": " << what << " camera '" << camera_->info().id << "' ("
+              << r.width << "x" << r.height << " " << camera_->pixel_format() << ", "
+              << camera_->frame_rate() << " fps, " << camera_->buffer_count() << " buffers)\n";
+  }
+
+  void send(Context& ctx, aravis::Frame frame) {
+    VideoFrame message;
+    // `frame` counts delivered frames: unlike the camera's 16-bit block id it never wraps and
+    // stays monotonic across reconnections.
+    message.header = {"camera" + std::to_string(camera_id_), seq_, frame.capture_ns,
+                      static_cast<std::int64_t>(seq_)};
+    message.camera_id = camera_id_;
+    message.image = std::move(frame.image);
+    ctx.send("frames", std::move(message));
+    ++seq_;
+  }
+
+  // Incomplete and never-seen frames count as this node's drops (shown with the graph's stats).
+  void account_drops(Context& ctx) {
+    const aravis::StreamCounters now = camera_->counters();
+    for (auto n = now.incomplete + now.skipped_ids; n > seen_drops_; ++seen_drops_)
+      ctx.count_drop();
+    incomplete_ = base_incomplete_ + now.incomplete;
+    skipped_ = base_skipped_ + now.skipped_ids;
+  }
+
+  void lose(Context& ctx) {
+    std::cerr << ctx.node_name() << ": camera '" << camera_->info().id
+              << "' lost (control-lost); reconnecting\n";
+    base_incomplete_ = incomplete_;
+    base_skipped_ = skipped_;
+    seen_drops_ = 0;
+    camera_.reset();
+  }
+
+  // One attempt per call; between attempts the node sleeps (waking early when the graph stops).
+  bool reconnect(Context& ctx) {
+    try {
+      camera_.emplace(settings_);
+    } catch (const std::runtime_error&) {
+      ctx.sleep_for(std::chrono::milliseconds(500));
+      return false;
+    }
+    ++reconnects_;
+    report_open(ctx, "reconnected to");
+    return true;
+  }
+
+  aravis::CameraSettings settings_;
+  std::optional<aravis::Camera> camera_;
+  std::uint64_t count_ = 0, seq_ = 0;
+  int camera_id_ = 0;
+  std::uint64_t seen_drops_ = 0, incomplete_ = 0, skipped_ = 0, base_incomplete_ = 0,
+                base_skipped_ = 0, reconnects_ = 0;
+};
+
+MOCAP_REGISTER_NODE("source.aravis", AravisSource)
+
+}  // namespace mocap::nodes
