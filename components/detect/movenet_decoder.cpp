@@ -184,8 +184,8 @@ std::vector<MovenetPerson> select_people(const std::array<MovenetRow, kMovenetIn
                                          const MovenetThresholds& thresholds) {
   const auto tw = static_cast<float>(mapping.tensor_width);
   const auto th = static_cast<float>(mapping.tensor_height);
-  const auto to_x = [&](float x) { return (x * tw - mapping.pad_left) / mapping.scale; };
-  const auto to_y = [&](float y) { return (y * th - mapping.pad_top) / mapping.scale; };
+  const auto to_x = [&](float x) { return (x * tw - mapping.pad_left) / mapping.scale_x; };
+  const auto to_y = [&](float y) { return (y * th - mapping.pad_top) / mapping.scale_y; };
   std::vector<MovenetPerson> people;
   for (const MovenetRow& row : rows) {
     const int base = 3 * kMovenetKeypoints;

@@ -34,10 +34,11 @@ using MovenetRow = std::array<float, kMovenetRowSize>;
 // Throws std::invalid_argument when the head sizes do not match height × width × channels.
 std::array<MovenetRow, kMovenetInstances> decode_movenet(const MovenetHeads& heads);
 
-// Where the fed tensor came from: image = (tensor - pad) / scale, in pixels.
+// Where the fed tensor came from: image = (tensor - pad) / scale, in pixels (x and y scales
+// differ slightly when the short side was rounded to whole pixels).
 struct TensorMapping {
   int tensor_width = 0, tensor_height = 0;
-  float scale = 1;
+  float scale_x = 1, scale_y = 1;
   float pad_left = 0, pad_top = 0;
 };
 

@@ -140,7 +140,7 @@ TEST(MovenetDecoder, SelectPeopleAppliesThresholdsSortsAndMapsToPixels) {
   rows[1][box + 2] = 0.75f;
   rows[1][box + 3] = 1.0f;
   // A 256×192 tensor from a 768×576 frame (scale 1/3) padded 10 px on the left.
-  const TensorMapping mapping{256, 192, 1.0f / 3.0f, 10.0f, 0.0f};
+  const TensorMapping mapping{256, 192, 1.0f / 3.0f, 1.0f / 3.0f, 10.0f, 0.0f};
   const auto people =
       select_people(rows, mapping, {.min_person_score = 0.25f, .min_keypoint_score = 0.3f});
   ASSERT_EQ(people.size(), 2u);

@@ -130,7 +130,10 @@ TEST_F(MovenetGolden, PeopleInFramePixelsMatchTfjs) {
   const auto rows = decode_movenet(run_case(c));
   const double scale = c.at("prepared_from").at("scale");
   const TensorMapping mapping{c.at("input_tensor").at("shape")[2],
-                              c.at("input_tensor").at("shape")[1], static_cast<float>(scale), 0.0f,
+                              c.at("input_tensor").at("shape")[1],
+                              static_cast<float>(scale),
+                              static_cast<float>(scale),
+                              0.0f,
                               0.0f};
   const auto people =
       select_people(rows, mapping, {.min_person_score = 0.0f, .min_keypoint_score = 0.0f});
