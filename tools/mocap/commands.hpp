@@ -11,5 +11,6 @@ int eval_command(int argc, char** argv);
 // `mocap eval humaneva`, reached through eval_command.
 int humaneva_eval_command(int argc, char** argv);
 int reconstruct_command(int argc, char** argv);
+int camera_command(int argc, char** argv);
 
 }  // namespace mocap::cli

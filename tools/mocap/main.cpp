@@ -23,6 +23,8 @@ constexpr Command kCommands[] = {
     {"graph", "validate a graph file, inspect node types, export Graphviz",
      mocap::cli::graph_command},
     {"eval", "measure accuracy: virtual-video and HumanEva-I protocols", mocap::cli::eval_command},
+    {"camera", "GigE/USB3 Vision cameras (Aravis): list them, grab frames to files",
+     mocap::cli::camera_command},
 };
 
 void print_usage(std::ostream& out) {

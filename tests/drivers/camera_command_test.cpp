@@ -1,0 +1,70 @@
+// `mocap camera list|grab` driven as a user would, against the fake GigE camera; and the live
+// GigE graph validated by `mocap graph validate`.
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "fake_gv_camera.hpp"
+#include "support/mocap_process.hpp"
+
+namespace mocap::test {
+namespace {
+
+using namespace std::chrono_literals;
+
+class CameraCommandTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    program_ = fake_camera_program();
+    if (!program_) GTEST_SKIP() << kFakeCameraProgram << " not on PATH (package aravis-tools)";
+  }
+  std::optional<std::string> program_;
+  TempDir dir_;
+};
+
+TEST_F(CameraCommandTest, ListShowsTheFakeCamera) {
+  FakeGvCamera fake(*program_, unique_serial("CLI"));
+  Mocap list(dir_, "list", {"camera", "list"});
+  ASSERT_EQ(list.wait(30s), 0) << list.err();
+  const std::string out = list.out();
+  EXPECT_NE(out.find(fake.serial()), std::string::npos) << out;
+  EXPECT_NE(out.find("127.0.0.1"), std::string::npos) << out;
+  EXPECT_NE(out.find("Aravis"), std::string::npos) << out;
+}
+
+TEST_F(CameraCommandTest, GrabSavesFramesAndPrintsTheRate) {
+  FakeGvCamera fake(*program_, unique_serial("CLI"));
+  const auto out_dir = dir_.path() / "frames";
+  Mocap grab(dir_, "grab",
+             {"camera", "grab", "--id", fake.serial(), "--frames", "5", "--out", out_dir.string(),
+              "--width", "64", "--height", "48", "--fps", "50", "--pixel-format", "Mono8"});
+  ASSERT_EQ(grab.wait(60s), 0) << grab.err();
+  EXPECT_NE(grab.out().find("grabbed 5 frames"), std::string::npos) << grab.out();
+  EXPECT_NE(grab.out().find("drops: "), std::string::npos) << grab.out();
+  for (int i = 0; i < 5; ++i) {
+    const auto file = out_dir / ("frame_00000" + std::to_string(i) + ".pgm");
+    ASSERT_TRUE(std::filesystem::exists(file)) << file;
+    const std::string header = "P5\n64 48\n255\n";
+    EXPECT_EQ(std::filesystem::file_size(file), header.size() + 64u * 48u);
+    EXPECT_EQ(read_file(file.string()).substr(0, header.size()), header);
+  }
+}
+
+TEST_F(CameraCommandTest, GrabFromAnUnknownCameraNamesIt) {
+  Mocap grab(dir_, "grab",
+             {"camera", "grab", "--id", "no-such-camera-4711", "--out", dir_.file("x")});
+  const auto code = grab.wait(30s);
+  ASSERT_TRUE(code.has_value());
+  EXPECT_NE(*code, 0);
+  EXPECT_NE(grab.err().find("no-such-camera-4711"), std::string::npos) << grab.err();
+}
+
+TEST(LiveGigeGraph, Validates) {
+  TempDir dir;
+  Mocap validate(dir, "validate", {"graph", "validate", "graphs/live_gige.yaml"});
+  ASSERT_EQ(validate.wait(30s), 0) << validate.err() << validate.out();
+}
+
+}  // namespace
+}  // namespace mocap::test
