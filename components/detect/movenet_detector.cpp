@@ -81,7 +81,9 @@ MovenetInput prepare_movenet_input(const ImageBuffer& image, int input_size) {
 
 MovenetDetector::MovenetDetector(const std::filesystem::path& model_json,
                                  const MovenetOptions& options)
-    : options_((check_input_size(options.input_size), options)), network_(model_json) {}
+    : options_((check_input_size(options.input_size), options)), network_(model_json) {
+  if (options_.threads > 0) cv::setNumThreads(options_.threads);
+}
 
 std::vector<MovenetPerson> MovenetDetector::detect(const ImageBuffer& image) {
   const MovenetInput input = prepare_movenet_input(image, options_.input_size);

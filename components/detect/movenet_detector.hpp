@@ -18,6 +18,9 @@ struct MovenetOptions {
   // fastest useful size; 384-512 find small or distant people.
   int input_size = 256;
   MovenetThresholds thresholds;
+  // cv::dnn threads, 0 for OpenCV's default. OpenCV's setting is process-wide: the last detector
+  // made decides.
+  int threads = 0;
 };
 
 // The tensor the network is fed (rgb8, sides multiples of 32) and how it maps back.

@@ -1,0 +1,131 @@
+// detect.movenet in a graph: video frames in, COCO-17 people out with the frames' headers; a
+// missing model or a bad input size stops the graph with an error naming the node and the fix.
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <memory>
+#include <mutex>
+#include <vector>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include "detect/model_files.hpp"
+#include "graph/registry.hpp"
+#include "sink_test_util.hpp"
+
+namespace mocap::nodes {
+namespace {
+
+using namespace mocap::graph;
+namespace fs = std::filesystem;
+
+const fs::path kFrame =
+    fs::path("..") / "shared" / "docs" / "models" / "movenet-multipose" / "vtest-f300.png";
+
+// unit.image_file: one PNG sent `count` times as bgr8 frames.
+class ImageFileSource : public Node {
+ public:
+  static void contract(Contract& c) {
+    c.output<VideoFrame>("frames");
+    c.required_param<std::string>("path", "image file");
+    c.param<int>("count", 1, "frames to send", {1, 1000});
+  }
+  void open(Context& ctx) override {
+    image_ = std::make_shared<cv::Mat>(cv::imread(ctx.param<std::string>("path")));
+    if (image_->empty()) throw std::runtime_error("cannot read " + ctx.param<std::string>("path"));
+    count_ = ctx.param<int>("count");
+  }
+  void process(Context& ctx) override {
+    if (sent_ == count_) return ctx.finish();
+    VideoFrame frame;
+    frame.header = {"camera0", static_cast<std::uint64_t>(sent_), 1000 + sent_, sent_};
+    frame.image =
+        ImageBuffer(image_->cols, image_->rows, static_cast<int>(image_->step[0]),
+                    PixelFormat::bgr8, image_, reinterpret_cast<const std::byte*>(image_->data));
+    ctx.send("frames", std::move(frame));
+    ++sent_;
+  }
+
+ private:
+  std::shared_ptr<cv::Mat> image_;
+  int count_ = 0, sent_ = 0;
+};
+MOCAP_REGISTER_NODE("unit.image_file", ImageFileSource)
+
+// unit.capture_people2d: keeps every People2D it receives for the test to look at.
+std::mutex captured_mutex;
+std::vector<People2D> captured;
+
+class CapturePeople2D : public Node {
+ public:
+  static void contract(Contract& c) { c.input<People2D>("in"); }
+  void process(Context& ctx) override {
+    const std::lock_guard lock(captured_mutex);
+    captured.push_back(ctx.input<People2D>("in"));
+  }
+};
+MOCAP_REGISTER_NODE("unit.capture_people2d", CapturePeople2D)
+
+std::string graph_yaml(const std::string& detector_params) {
+  return R"(
+nodes:
+  src: { type: unit.image_file, params: { path: )" +
+         kFrame.string() + R"(, count: 2 } }
+  det: { type: detect.movenet, params: { )" +
+         detector_params + R"( } }
+  out: { type: unit.capture_people2d }
+edges:
+  - [src.frames, det.in]
+  - [det.out, out.in]
+)";
+}
+
+TEST(MovenetNode, SendsCoco17PeopleInFramePixelsWithTheFrameHeaders) {
+  try {
+    detect::movenet_model_json();
+  } catch (const detect::ModelMissing& e) {
+    GTEST_SKIP() << e.what();
+  }
+  if (!fs::exists(kFrame)) GTEST_SKIP() << "reference frame absent: " << kFrame;
+  captured.clear();
+  const RunResult result = testing::run_graph(graph_yaml("input_size: 512, min_person_score: 0.2"));
+  ASSERT_TRUE(result.ok) << result.error;
+  ASSERT_EQ(captured.size(), 2u);
+  for (std::size_t i = 0; i < captured.size(); ++i) {
+    const People2D& people = captured[i];
+    EXPECT_EQ(people.header.frame, static_cast<std::int64_t>(i));
+    EXPECT_EQ(people.header.capture_ns, 1000 + static_cast<std::int64_t>(i));
+    EXPECT_EQ(people.layout, LayoutId::coco17);
+    ASSERT_EQ(people.people.size(), 6u);  // the six pedestrians (scores 0.36 .. 0.21)
+    for (const Person2D& p : people.people) {
+      EXPECT_EQ(p.id, -1);
+      ASSERT_EQ(p.joints.size(), 17u);
+      EXPECT_GT(p.box.height, 50.0f);  // 65-90 px tall people in the 768x576 frame
+      EXPECT_LT(p.box.height, 150.0f);
+    }
+  }
+}
+
+TEST(MovenetNode, AMissingModelStopsTheGraphNamingTheSetupCommand) {
+  if (!fs::exists(kFrame)) GTEST_SKIP() << "reference frame absent: " << kFrame;
+  const RunResult result = testing::run_graph(graph_yaml("model: /nonexistent/movenet.json"));
+  ASSERT_FALSE(result.ok);
+  EXPECT_NE(result.error.find("'det'"), std::string::npos) << result.error;
+  EXPECT_NE(result.error.find("tools/setup.sh --models-only"), std::string::npos) << result.error;
+}
+
+TEST(MovenetNode, RefusesAnInputSizeThatIsNotAMultipleOf32) {
+  try {
+    detect::movenet_model_json();
+  } catch (const detect::ModelMissing& e) {
+    GTEST_SKIP() << e.what();
+  }
+  if (!fs::exists(kFrame)) GTEST_SKIP() << "reference frame absent: " << kFrame;
+  const RunResult result = testing::run_graph(graph_yaml("input_size: 250"));
+  ASSERT_FALSE(result.ok);
+  EXPECT_NE(result.error.find("multiple of 32"), std::string::npos) << result.error;
+}
+
+}  // namespace
+}  // namespace mocap::nodes
