@@ -2,6 +2,7 @@
 
 #include "posedb/view_set.hpp"
 #include "recon/savitzky_golay.hpp"
+#include "recon/view_refinement.hpp"
 
 namespace mocap::recon {
 
@@ -30,10 +31,14 @@ std::string_view smoothing_name(Smoothing s) {
 }
 
 Pose3D pose_in_camera(const posedb::Database& db, const Candidate& chosen) {
+  return pose_in_camera(db, chosen, db.views()[chosen.view]);
+}
+
+Pose3D pose_in_camera(const posedb::Database& db, const Candidate& chosen,
+                      const posedb::View& view) {
   Pose3D pose;
   pose.valid = true;
   pose.chosen = chosen;
-  const posedb::View& view = db.views()[chosen.view];
   const posedb::CameraPose camera = posedb::camera_pose(view, db.build_info().views.root_height_m);
   pose.body_to_camera = camera.world_to_camera;
   const auto j = db.joints(chosen.frame);
@@ -41,6 +46,17 @@ Pose3D pose_in_camera(const posedb::Database& db, const Candidate& chosen) {
     pose.joints[b] = camera.world_to_camera * glm::vec3(j[3 * b], j[3 * b + 1], j[3 * b + 2]);
   }
   return pose;
+}
+
+Pose3D refined_pose_in_camera(const posedb::Database& db, const Candidate& chosen,
+                              const posedb::PoseVector& query) {
+  const auto j = db.joints(chosen.frame);
+  std::array<glm::vec3, kBodyJoints> body;
+  for (int b = 0; b < kBodyJoints; ++b) body[b] = {j[3 * b], j[3 * b + 1], j[3 * b + 2]};
+  const posedb::View view =
+      refine_view(body, query, db.views()[chosen.view], db.build_info().views.root_height_m,
+                  db.build_info().scaling);
+  return pose_in_camera(db, chosen, view);
 }
 
 void turn_onto_ray(Pose3D& pose, const Pinhole& camera, glm::vec2 root_pixel) {
@@ -113,6 +129,15 @@ std::vector<Pose3D> reconstruct_sequence(Matcher& matcher, const FrameBones& bon
       const std::size_t pick =
           options.selection == Selection::nearest ? 0 : selector.select(candidates[t]);
       poses[t] = pose_in_camera(db, candidates[t][pick]);
+    }
+  }
+  if (options.refine_view) {
+    for (std::size_t t = 0; t < frames.size(); ++t) {
+      posedb::PoseVector query;
+      if (poses[t].valid &&
+          normalize_body(frames[t], db.build_info().scaling, matcher.options().scaler, query)) {
+        poses[t] = refined_pose_in_camera(db, poses[t].chosen, query);
+      }
     }
   }
   if (options.camera.valid()) {

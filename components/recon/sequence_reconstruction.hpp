@@ -36,6 +36,8 @@ struct SequenceOptions {
   double fps = 24.0;
   // When valid, every pose is turned onto the ray through its root's pixel (ray_alignment.hpp).
   Pinhole camera;
+  // Search yaw and elevation around the matched view for the best fit (view_refinement.hpp).
+  bool refine_view = false;
 };
 
 using BodyXyc = std::array<float, kBodyJoints * 3>;  // 15 joints (x, y, confidence), image pixels
@@ -49,8 +51,13 @@ struct Pose3D {
   glm::quat body_to_camera{1.0f, 0.0f, 0.0f, 0.0f};
 };
 
-// The database pose of `chosen` as seen by its view's camera.
+// The database pose of `chosen` as seen by its view's camera, or by another `view`.
 Pose3D pose_in_camera(const posedb::Database& db, const Candidate& chosen);
+Pose3D pose_in_camera(const posedb::Database& db, const Candidate& chosen,
+                      const posedb::View& view);
+// The same from the view refined against the person's normalised 2D pose `query`.
+Pose3D refined_pose_in_camera(const posedb::Database& db, const Candidate& chosen,
+                              const posedb::PoseVector& query);
 
 std::vector<Pose3D> reconstruct_sequence(Matcher& matcher, const FrameBones& bones,
                                          std::span<const BodyXyc> frames,

@@ -78,7 +78,7 @@ TEST_F(ReconstructTest, DamagedInputIsReportedAndEveryFrameIsWritten) {
       const auto root = p.at("joints").at("root");
       EXPECT_EQ(root[0].get<double>(), 0.0);  // root-relative
       const auto head = p.at("joints").at("head");
-      EXPECT_LT(head[1].get<double>(), -0.3);  // the head is above the root (y down)
+      EXPECT_LT(head[1].get<double>(), -0.15);  // the head is above the root (y down), seated people too
     }
     if (i == 7 || i == 12) {
       EXPECT_TRUE(j.at("people").empty()) << "frame " << i;

@@ -38,21 +38,30 @@ std::vector<Config> make_configs(const posedb::Database& full, const posedb::Dat
   path_sg.sequence.selection = recon::Selection::path;
   path_sg.sequence.smoothing = recon::Smoothing::savitzky_golay;
   configs.push_back(path_sg);
-  Config full_offline = path_sg;
-  full_offline.name = "full: path + SG";
-  full_offline.description =
+  Config ray_only = path_sg;
+  ray_only.name = "path + SG + ray";
+  ray_only.description =
       "all views, Viterbi path, Savitzky-Golay (3, 11), pose turned onto the root's ray";
-  full_offline.align_to_ray = true;
+  ray_only.align_to_ray = true;
+  configs.push_back(ray_only);
+  Config full_offline = ray_only;
+  full_offline.name = "full: path + SG + ray + view";
+  full_offline.description =
+      "all views, Viterbi path, Savitzky-Golay (3, 11), view refined against the 2D pose, pose "
+      "turned onto the "
+      "root's ray";
+  full_offline.sequence.refine_view = true;
   configs.push_back(full_offline);
-  Config full_live{
-      "full live: path + 1-Euro",
-      "all views, Viterbi path, 1-Euro (beta 0.4, fc_min 1), pose turned onto the root's ray",
-      &full,
-      {},
-      base};
+  Config full_live{"full live: path + 1-Euro",
+                   "all views, Viterbi path, 1-Euro (beta 0.4, fc_min 1), view refined, pose "
+                   "turned onto the root's ray",
+                   &full,
+                   {},
+                   base};
   full_live.sequence.selection = recon::Selection::path;
   full_live.sequence.smoothing = recon::Smoothing::one_euro;
   full_live.align_to_ray = true;
+  full_live.sequence.refine_view = true;
   configs.push_back(full_live);
   return configs;
 }

@@ -76,11 +76,16 @@ class TemporalSelectorNode : public Node {
   void process(Context& ctx) override {
     const auto& in = ctx.input<PoseMatches>("in");
     const std::int64_t t = next_frame_++;
-    pending_.push_back({ctx.header(), {}, {}});
+    pending_.push_back({ctx.header(), {}, {}, {}});
     for (const PersonMatch& person : in.people) {
       if (person.id < 0) continue;  // untracked: no history to choose with
       const Keypoint2D& root = person.body[index(Joint::root)];
       pending_.back().root_pixel[person.id] = {root.x, root.y};
+      if (person.normalized_ok) {
+        posedb::PoseVector query;
+        std::copy(person.normalized.begin(), person.normalized.end(), query.begin());
+        pending_.back().query[person.id] = query;
+      }
       Track& track = tracks_[person.id];
       if (!track.path && !track.greedy) start(track, t);
       track.last_seen = t;
@@ -118,7 +123,8 @@ class TemporalSelectorNode : public Node {
   struct PendingFrame {
     Header header;
     std::vector<Person3D> people;
-    std::map<int, glm::vec2> root_pixel;  // of each person in this frame's input
+    std::map<int, glm::vec2> root_pixel;      // of each person in this frame's input
+    std::map<int, posedb::PoseVector> query;  // each person's normalised 2D pose
   };
 
   void start(Track& track, std::int64_t t) {
@@ -161,6 +167,9 @@ class TemporalSelectorNode : public Node {
     if (slot < 0 || slot >= static_cast<std::int64_t>(pending_.size())) return;  // already sent
     PendingFrame& pending = pending_[static_cast<std::size_t>(slot)];
     recon::Pose3D turned = pose;
+    if (const auto query = pending.query.find(id); refine_view_ && query != pending.query.end()) {
+      turned = recon::refined_pose_in_camera(*db_, pose.chosen, query->second);
+    }
     if (const auto root = pending.root_pixel.find(id);
         camera_.valid() && root != pending.root_pixel.end()) {
       recon::turn_onto_ray(turned, camera_, root->second);
@@ -190,6 +199,7 @@ class TemporalSelectorNode : public Node {
   int lag_ = 0;
   int max_missed_ = 10;
   recon::Pinhole camera_;  // invalid: poses stay as the database cameras see them
+  bool refine_view_ = true;
   std::map<int, Track> tracks_;
   std::deque<PendingFrame> pending_;
   std::int64_t next_frame_ = 0, first_pending_ = 0;
