@@ -56,8 +56,14 @@ struct Weight {
   std::string content;  // little-endian float32 or int32 values, as TensorProto.tensor_content
 };
 
+// Errors that already name the model file; anything else thrown inside gets the name added.
+class ModelError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
 [[noreturn]] void fail(const std::filesystem::path& file, const std::string& what) {
-  throw std::runtime_error("TF.js model " + file.string() + ": " + what);
+  throw ModelError("TF.js model " + file.string() + ": " + what);
 }
 
 std::string read_file(const std::filesystem::path& path, const std::filesystem::path& model) {
@@ -441,8 +447,10 @@ std::string tfjs_to_graphdef(const std::filesystem::path& model_json,
         model["modelTopology"].value("versions", json::object()).value("producer", 808));
     graph.add_message(pb::kGraphVersions, versions);
     return graph.bytes();
-  } catch (const json::exception& e) {
-    fail(model_json, std::string("unexpected structure: ") + e.what());
+  } catch (const ModelError&) {
+    throw;
+  } catch (const std::exception& e) {  // JSON structure, numbers, data types
+    fail(model_json, e.what());
   }
 }
 

@@ -86,8 +86,8 @@ std::string tiny_weights() {
 struct TinyModel {
   test::TempDir dir;
   std::filesystem::path json = dir.path() / "tiny.json";
-  explicit TinyModel(const std::string& weights = tiny_weights()) {
-    std::ofstream(json) << kTinyModel;
+  explicit TinyModel(const std::string& weights = tiny_weights(), std::string text = kTinyModel) {
+    std::ofstream(json) << text;
     std::ofstream(dir.path() / "tiny.bin", std::ios::binary) << weights;
   }
 };
@@ -133,6 +133,23 @@ TEST(TfjsGraph, RefusesUnknownOutputsAndShortWeights) {
   EXPECT_THROW(tfjs_to_graphdef(TinyModel(tiny_weights().substr(0, 6)).json, conv),
                std::runtime_error);
   EXPECT_THROW(tfjs_to_graphdef("/nonexistent/model.json", conv), std::runtime_error);
+}
+
+TEST(TfjsGraph, ErrorsInsideTheGraphNameTheFile) {
+  std::string text = kTinyModel;
+  const std::string conv_type = R"("T": {"type": "DT_FLOAT"}, "strides")";
+  text.replace(text.find(conv_type), conv_type.size(),
+               R"("T": {"type": "DT_COMPLEX64"}, "strides")");
+  const TinyModel model(tiny_weights(), text);
+  const std::vector<std::string> conv = {"conv"};
+  try {
+    tfjs_to_graphdef(model.json, conv);
+    FAIL() << "expected an error";
+  } catch (const std::runtime_error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("tiny.json"), std::string::npos) << what;
+    EXPECT_NE(what.find("DT_COMPLEX64"), std::string::npos) << what;
+  }
 }
 
 }  // namespace
