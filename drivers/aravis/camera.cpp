@@ -68,6 +68,8 @@ std::optional<DeviceInfo> discover(const std::string& wanted) {
   return std::nullopt;
 }
 
+using FakeFill = std::function<void(std::span<std::byte>, int, int)>;
+
 void on_control_lost(ArvDevice*, gpointer flag) {
   static_cast<std::atomic<bool>*>(flag)->store(true);  // Aravis' heartbeat thread
 }
@@ -90,10 +92,12 @@ void enable_fake_interface() { arv_enable_interface("Fake"); }
 
 struct Camera::Impl {
   DeviceInfo info;
-  std::string label;  // how errors name the camera
+  std::string label;   // how errors name the camera
+  FakeFill fake_fill;  // declared first, so it outlives the camera and stream that call it
   GPtr<ArvCamera> camera;
   GPtr<ArvStream> stream;
   gulong lost_handler = 0;
+  std::size_t payload = 0;  // bytes of each stream buffer
   std::atomic<bool> lost{false};
   CameraFormat format = CameraFormat::mono8;
   int buffers = 0;
@@ -112,6 +116,8 @@ struct Camera::Impl {
   }
 
   void open(const CameraSettings& settings);
+  void install_fake_fill(const FakeFill& fill);
+  static void fill_fake_buffer(ArvBuffer* buffer, void* self, guint32, guint32, ArvPixelFormat);
   void apply(const CameraSettings& settings);
   void start(const CameraSettings& settings);
   std::optional<Frame> take(ArvBuffer* buffer);
@@ -136,8 +142,29 @@ void Camera::Impl::open(const CameraSettings& settings) {
     info.serial = text(arv_camera_get_device_serial_number(camera.get(), error.out()));
   }
   if (settings.id.empty()) label = info.id;
+  if (settings.fake_fill) install_fake_fill(settings.fake_fill);
   lost_handler = g_signal_connect(arv_camera_get_device(camera.get()), "control-lost",
                                   G_CALLBACK(on_control_lost), &lost);
+}
+
+void Camera::Impl::install_fake_fill(const FakeFill& fill) {
+  ArvDevice* device = arv_camera_get_device(camera.get());
+  if (!ARV_IS_FAKE_DEVICE(device))
+    throw std::runtime_error("camera '" + label + "' is not Aravis' in-process fake camera");
+  fake_fill = fill;
+  arv_fake_camera_set_fill_pattern(arv_fake_device_get_fake_camera(ARV_FAKE_DEVICE(device)),
+                                   fill_fake_buffer, this);
+}
+
+// Called by the fake camera for every frame, on its streaming thread, after it has set the
+// buffer's geometry. Only Aravis' own patterns can set the received size, so with ours the buffer
+// reports 0 bytes: its whole allocation (`payload`, fixed before acquisition started) is the image.
+void Camera::Impl::fill_fake_buffer(ArvBuffer* buffer, void* self, guint32, guint32,
+                                    ArvPixelFormat) {
+  const auto* impl = static_cast<const Impl*>(self);
+  auto* data = static_cast<std::byte*>(const_cast<void*>(arv_buffer_get_data(buffer, nullptr)));
+  impl->fake_fill({data, impl->payload}, arv_buffer_get_image_width(buffer),
+                  arv_buffer_get_image_height(buffer));
 }
 
 void Camera::Impl::apply(const CameraSettings& settings) {
@@ -181,7 +208,7 @@ void Camera::Impl::apply(const CameraSettings& settings) {
 void Camera::Impl::start(const CameraSettings& settings) {
   ErrorSlot error;
   ArvCamera* cam = camera.get();
-  const guint payload = arv_camera_get_payload(cam, error.out());
+  payload = arv_camera_get_payload(cam, error.out());
   error.throw_if_failed(label, "cannot read the payload size");
   const double rate = arv_camera_get_frame_rate(cam, error.out());
   if (error.failed()) error.out();  // cameras without a rate feature: size the pool for 30 fps
@@ -216,12 +243,18 @@ std::optional<Frame> Camera::Impl::take(ArvBuffer* buffer) {
   if (!buffer_format)
     throw std::runtime_error("camera '" + label + "' sent " + describe_pfnc(pfnc) +
                              ", which is not supported");
+  const int width = arv_buffer_get_image_width(buffer);
+  const int height = arv_buffer_get_image_height(buffer);
   std::size_t size = 0;
   const void* data = arv_buffer_get_image_data(buffer, &size);
+  if (size == 0 && fake_fill) size = payload;  // see fill_fake_buffer
+  if (width <= 0 || height <= 0 || size < image_bytes(width, height, *buffer_format)) {
+    ++counters.incomplete;  // geometry and bytes disagree: never pass such an image on
+    return std::nullopt;
+  }
   Frame frame;
   frame.image =
-      convert_image({static_cast<const std::byte*>(data), size}, arv_buffer_get_image_width(buffer),
-                    arv_buffer_get_image_height(buffer), *buffer_format);
+      convert_image({static_cast<const std::byte*>(data), size}, width, height, *buffer_format);
   frame.frame_id = arv_buffer_get_frame_id(buffer);
   frame.device_ns = static_cast<std::int64_t>(arv_buffer_get_timestamp(buffer));
   frame.system_ns = static_cast<std::int64_t>(arv_buffer_get_system_timestamp(buffer));

@@ -5,8 +5,10 @@
 
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -34,6 +36,10 @@ struct CameraSettings {
   std::optional<double> gain;    // none: leave it
   std::string pixel_format;      // GenICam name (Mono8, BayerRG8, ...); empty: leave it
   int buffers = 0;               // stream buffers; 0: half a second of frames (4..64)
+  // Only for Aravis' in-process fake camera (enable_fake_interface): writes the pixels of every
+  // frame, on Aravis' streaming thread, so tests can send their own images through the camera
+  // path. Opening any other camera with it set fails.
+  std::function<void(std::span<std::byte> pixels, int width, int height)> fake_fill;
 };
 
 struct Frame {

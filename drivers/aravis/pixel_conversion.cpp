@@ -15,7 +15,9 @@ constexpr std::array kFormats = {
     CameraFormat::bgr8,      CameraFormat::yuv422_uyvy, CameraFormat::yuv422_yuyv,
 };
 
-std::size_t packed_bytes(int width, int height, CameraFormat format) {
+}  // namespace
+
+std::size_t image_bytes(int width, int height, CameraFormat format) {
   const std::size_t pixels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
   switch (format) {
     case CameraFormat::rgb8:
@@ -28,6 +30,8 @@ std::size_t packed_bytes(int width, int height, CameraFormat format) {
       return pixels;
   }
 }
+
+namespace {
 
 void copy_rows(std::span<const std::byte> src, ImageBuffer& out, int row_bytes) {
   const auto dst = out.pixels_for_writing();
@@ -168,7 +172,7 @@ ImageBuffer convert_image(std::span<const std::byte> bytes, int width, int heigh
   const bool yuv = format == CameraFormat::yuv422_uyvy || format == CameraFormat::yuv422_yuyv;
   if (yuv && width % 2 != 0)
     throw std::invalid_argument(std::string(name(format)) + " needs an even width");
-  const std::size_t needed = packed_bytes(width, height, format);
+  const std::size_t needed = image_bytes(width, height, format);
   if (bytes.size() < needed) {
     throw std::invalid_argument(std::string(name(format)) + " image of " + std::to_string(width) +
                                 "x" + std::to_string(height) + " needs " + std::to_string(needed) +

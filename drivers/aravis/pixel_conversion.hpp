@@ -33,6 +33,9 @@ PixelFormat converted_format(CameraFormat format);
 // "PixelFormat 0x01100005" for codes the driver does not convert.
 std::string describe_pfnc(std::uint32_t pfnc);
 
+// Bytes of a packed image of this geometry and format (what convert_image needs).
+std::size_t image_bytes(int width, int height, CameraFormat format);
+
 // Converts one camera image (rows packed, as GVSP/U3V deliver them) into a new ImageBuffer.
 // Throws std::invalid_argument when `bytes` is shorter than the geometry needs.
 ImageBuffer convert_image(std::span<const std::byte> bytes, int width, int height,

@@ -156,6 +156,19 @@ TEST_F(FakeCameraTest, AnUnsupportedPixelFormatIsNamed) {
   }
 }
 
+// Filling frames with a test's own pixels is for Aravis' in-process fake camera only.
+TEST_F(FakeCameraTest, AFillFunctionIsRefusedForOtherCameras) {
+  const auto fake = start();
+  CameraSettings s = mono8(fake->serial(), 25);
+  s.fake_fill = [](std::span<std::byte>, int, int) {};
+  try {
+    Camera camera(s);
+    FAIL() << "a GigE camera accepted a fill function";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("in-process fake"), std::string::npos) << e.what();
+  }
+}
+
 TEST_F(FakeCameraTest, ControlLostIsSeenWhenTheCameraDies) {
   auto fake = start();
   Camera camera(mono8(fake->serial(), 25));
