@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <mutex>
 #include <stdexcept>
 
 #include "pixel_conversion.hpp"
@@ -76,7 +77,17 @@ void on_control_lost(ArvDevice*, gpointer flag) {
 
 }  // namespace
 
+// Aravis' device list is one global table that arv_update_device_list rebuilds: every use of it
+// (discovery, opening by id) takes this lock, so two camera nodes can reconnect at once.
+namespace {
+std::mutex& device_list_mutex() {
+  static std::mutex mutex;
+  return mutex;
+}
+}  // namespace
+
 std::vector<DeviceInfo> list_devices() {
+  const std::lock_guard lock(device_list_mutex());
   arv_update_device_list();
   std::vector<DeviceInfo> devices;
   const unsigned n = arv_get_n_devices();
@@ -88,7 +99,10 @@ std::vector<DeviceInfo> list_devices() {
   return devices;
 }
 
-void enable_fake_interface() { arv_enable_interface("Fake"); }
+void enable_fake_interface() {
+  const std::lock_guard lock(device_list_mutex());
+  arv_enable_interface("Fake");
+}
 
 struct Camera::Impl {
   DeviceInfo info;
@@ -130,7 +144,10 @@ void Camera::Impl::open(const CameraSettings& settings) {
   const auto found = discover(settings.id);
   const std::string id = found ? found->id : settings.id;
   ErrorSlot error;
-  camera.reset(arv_camera_new(id.empty() ? nullptr : id.c_str(), error.out()));
+  {
+    const std::lock_guard lock(device_list_mutex());
+    camera.reset(arv_camera_new(id.empty() ? nullptr : id.c_str(), error.out()));
+  }
   error.throw_if_failed(label, "cannot open");
   if (!camera) throw std::runtime_error("camera '" + label + "': cannot open (not found)");
   if (found) {
