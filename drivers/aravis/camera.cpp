@@ -116,7 +116,8 @@ struct Camera::Impl {
   CameraFormat format = CameraFormat::mono8;
   int buffers = 0;
   StreamCounters counters;
-  std::optional<std::uint64_t> last_id;
+  std::optional<std::uint64_t> last_id;  // of the last complete frame
+  std::uint64_t incomplete_since_last = 0;
   std::optional<std::int64_t> clock_offset;  // min(arrival - device time), see Camera::next
 
   ~Impl() {
@@ -135,7 +136,7 @@ struct Camera::Impl {
   void apply(const CameraSettings& settings);
   void start(const CameraSettings& settings);
   std::optional<Frame> take(ArvBuffer* buffer);
-  void track_id(std::uint64_t id);
+  void track_complete_id(std::uint64_t id);
 };
 
 void Camera::Impl::open(const CameraSettings& settings) {
@@ -242,17 +243,27 @@ void Camera::Impl::start(const CameraSettings& settings) {
   error.throw_if_failed(label, "cannot start acquisition");
 }
 
-void Camera::Impl::track_id(std::uint64_t id) {
-  // GigE Vision 1 block ids are 16 bits and wrap; an id not above the last one starts afresh.
-  if (last_id && id > *last_id + 1) counters.skipped_ids += id - *last_id - 1;
-  last_id = id;
+// Only complete frames' ids are trusted (a buffer that lost its leader may carry any id). Between
+// two of them, the ids not seen, less the incomplete buffers already counted, were never seen at
+// all. Ids far below the last one are a wrap (GigE Vision 1 block ids are 16 bits) or a restarted
+// camera, and a frame completed late (after a packet resend) was never counted as missing.
+void Camera::Impl::track_complete_id(std::uint64_t id) {
+  constexpr std::uint64_t kReorderWindow = 256;
+  if (!last_id || id + kReorderWindow < *last_id) {
+    last_id = id;
+  } else if (id > *last_id) {
+    const std::uint64_t missing = id - *last_id - 1;
+    counters.skipped_ids += missing > incomplete_since_last ? missing - incomplete_since_last : 0;
+    last_id = id;
+  }
+  incomplete_since_last = 0;
 }
 
 std::optional<Frame> Camera::Impl::take(ArvBuffer* buffer) {
-  track_id(arv_buffer_get_frame_id(buffer));
   if (arv_buffer_get_status(buffer) != ARV_BUFFER_STATUS_SUCCESS ||
       arv_buffer_get_payload_type(buffer) != ARV_BUFFER_PAYLOAD_TYPE_IMAGE) {
     ++counters.incomplete;
+    ++incomplete_since_last;
     return std::nullopt;
   }
   const auto pfnc = static_cast<std::uint32_t>(arv_buffer_get_image_pixel_format(buffer));
@@ -267,8 +278,10 @@ std::optional<Frame> Camera::Impl::take(ArvBuffer* buffer) {
   if (size == 0 && fake_fill) size = payload;  // see fill_fake_buffer
   if (width <= 0 || height <= 0 || size < image_bytes(width, height, *buffer_format)) {
     ++counters.incomplete;  // geometry and bytes disagree: never pass such an image on
+    ++incomplete_since_last;
     return std::nullopt;
   }
+  track_complete_id(arv_buffer_get_frame_id(buffer));
   Frame frame;
   frame.image =
       convert_image({static_cast<const std::byte*>(data), size}, width, height, *buffer_format);

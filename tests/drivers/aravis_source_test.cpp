@@ -44,13 +44,11 @@ class FrameRecorder : public Node {
 };
 MOCAP_REGISTER_NODE("unit.frame_recorder", FrameRecorder)
 
-std::string graph_text(const std::string& id, int count) {
+std::string graph_text(const std::string& id, int count, int width = 512, int height = 512) {
   return "nodes:\n"
          "  cam: { type: source.aravis, params: { id: " +
-         id +
-         ", fps: 25, width: 512, "
-         "height: 512, pixel_format: Mono8, count: " +
-         std::to_string(count) +
+         id + ", fps: 25, width: " + std::to_string(width) + ", height: " + std::to_string(height) +
+         ", pixel_format: Mono8, count: " + std::to_string(count) +
          " } }\n"
          "  rec: { type: unit.frame_recorder }\n"
          "edges:\n"
@@ -96,6 +94,24 @@ TEST_F(AravisSourceTest, EmitsFramesWithHeaders) {
       EXPECT_GT(seen[i].header.capture_ns, seen[i - 1].header.capture_ns);
     }
   }
+}
+
+// Packets lost on the way (the fake camera drops 3 % of them): incomplete frames are the node's
+// drops in the graph's statistics, and only whole frames reach the next node. Small frames (a
+// few packets each), so that most of them still arrive whole.
+TEST_F(AravisSourceTest, IncompleteFramesAreCountedAsDrops) {
+  test::FakeGvCamera fake(*program_, test::unique_serial("NODE"), /*loss_per_thousand=*/30);
+  Runtime runtime(resolve(parse_graph_text(graph_text(fake.serial(), 40, 128, 96), "test.yaml")));
+  const RunResult result = runtime.run();
+  ASSERT_TRUE(result.ok) << result.error;
+  std::uint64_t drops = 0;
+  for (const NodeStats& s : result.stats.nodes) {
+    if (s.node == "cam") drops = s.drops;
+  }
+  EXPECT_GT(drops, 0u);
+  const std::lock_guard lock(seen_mutex);
+  ASSERT_EQ(seen.size(), 40u);
+  for (const Seen& s : seen) EXPECT_EQ(s.width * s.height, 128 * 96);
 }
 
 TEST_F(AravisSourceTest, ACameraThatCannotBeOpenedFailsTheGraphNamingIt) {
