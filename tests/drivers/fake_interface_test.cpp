@@ -11,6 +11,8 @@
 #include <opencv2/videoio.hpp>
 
 #include "camera.hpp"
+#include "detect/model_files.hpp"
+#include "detect/movenet_detector.hpp"
 
 namespace mocap::aravis {
 namespace {
@@ -86,6 +88,46 @@ TEST(FakeInterface, VideoFramesArriveIntactAndInOrder) {
     if (i > 0) {
       EXPECT_EQ(seen[i], (seen[i - 1] + 1) % static_cast<int>(video.size())) << "frame " << i;
     }
+  }
+}
+
+// The detector (issue 5) on frames that came through the camera: it finds the pedestrians of the
+// video, exactly as it does on the video's own frames.
+TEST(FakeInterface, TheDetectorFindsPeopleInFramesFromTheCamera) {
+  if (!std::filesystem::exists(kVideo)) GTEST_SKIP() << kVideo << " not found";
+  std::filesystem::path model;
+  try {
+    model = detect::movenet_model_json();
+  } catch (const detect::ModelMissing& e) {
+    GTEST_SKIP() << e.what();
+  }
+  const std::vector<cv::Mat> video = read_rgb_frames(1);
+  ASSERT_EQ(video.size(), 1u);
+  const cv::Mat& f = video[0];
+  CameraSettings s;
+  s.id = fake_device_id();
+  ASSERT_FALSE(s.id.empty()) << "Aravis' Fake interface shows no camera";
+  s.pixel_format = "RGB8";
+  s.region = Region{0, 0, f.cols, f.rows};
+  s.fake_fill = [&](std::span<std::byte> pixels, int, int) {
+    std::memcpy(pixels.data(), f.data, std::min(pixels.size(), f.total() * f.elemSize()));
+  };
+  Camera camera(s);
+  const auto frame = camera.next(5s);
+  ASSERT_TRUE(frame);
+
+  // The settings of the detector's own test on this video: small, distant people need 512.
+  detect::MovenetDetector detector(model,
+                                   {.input_size = 512, .thresholds = {.min_person_score = 0.2f}});
+  const ImageBuffer original(f.cols, f.rows, static_cast<int>(f.step), PixelFormat::rgb8,
+                             std::shared_ptr<const void>(),
+                             reinterpret_cast<const std::byte*>(f.data));
+  const auto from_camera = detector.detect(frame->image);
+  const auto from_video = detector.detect(original);
+  EXPECT_GE(from_camera.size(), 2u) << "vtest shows several pedestrians";
+  ASSERT_EQ(from_camera.size(), from_video.size());
+  for (std::size_t i = 0; i < from_camera.size(); ++i) {
+    EXPECT_FLOAT_EQ(from_camera[i].score, from_video[i].score);
   }
 }
 
