@@ -132,6 +132,7 @@ struct Camera::Impl {
 
   void open(const CameraSettings& settings);
   void install_fake_fill(const FakeFill& fill);
+  void ensure_control();
   static void fill_fake_buffer(ArvBuffer* buffer, void* self, guint32, guint32, ArvPixelFormat);
   void apply(const CameraSettings& settings);
   void start(const CameraSettings& settings);
@@ -160,9 +161,27 @@ void Camera::Impl::open(const CameraSettings& settings) {
     info.serial = text(arv_camera_get_device_serial_number(camera.get(), error.out()));
   }
   if (settings.id.empty()) label = info.id;
+  ensure_control();
   if (settings.fake_fill) install_fake_fill(settings.fake_fill);
   lost_handler = g_signal_connect(arv_camera_get_device(camera.get()), "control-lost",
                                   G_CALLBACK(on_control_lost), &lost);
+}
+
+// Aravis opens a GigE camera it could not take control of (a slow answer on a busy host, or
+// another application holding it) read-only, without an error; streaming then fails with a
+// vaguer one. Two more attempts, then an error that says what is wrong.
+void Camera::Impl::ensure_control() {
+  ArvDevice* device = arv_camera_get_device(camera.get());
+  if (!ARV_IS_GV_DEVICE(device)) return;
+  auto* gv = ARV_GV_DEVICE(device);
+  for (int attempt = 0; attempt < 2 && !arv_gv_device_is_controller(gv); ++attempt) {
+    ErrorSlot ignored;  // the check after the loop reports the outcome
+    arv_gv_device_take_control(gv, ignored.out());
+  }
+  if (!arv_gv_device_is_controller(gv)) {
+    throw std::runtime_error("camera '" + label +
+                             "': cannot take control of it (is another application using it?)");
+  }
 }
 
 void Camera::Impl::install_fake_fill(const FakeFill& fill) {

@@ -70,10 +70,12 @@ class AravisSourceTest : public ::testing::Test {
     program_ = test::fake_camera_program();
     if (!program_)
       GTEST_SKIP() << test::kFakeCameraProgram << " not on PATH (package aravis-tools)";
+    lock_.emplace();  // see FakeCameraLock
     const std::lock_guard lock(seen_mutex);
     seen.clear();
   }
   std::optional<std::string> program_;
+  std::optional<test::FakeCameraLock> lock_;
 };
 
 TEST_F(AravisSourceTest, EmitsFramesWithHeaders) {

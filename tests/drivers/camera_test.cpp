@@ -22,6 +22,7 @@ class FakeCameraTest : public ::testing::Test {
     program_ = test::fake_camera_program();
     if (!program_)
       GTEST_SKIP() << test::kFakeCameraProgram << " not on PATH (package aravis-tools)";
+    lock_.emplace();  // see FakeCameraLock
   }
   std::unique_ptr<FakeGvCamera> start(int loss_per_thousand = 0) {
     return std::make_unique<FakeGvCamera>(*program_, test::unique_serial("MOCAP"),
@@ -43,6 +44,7 @@ class FakeCameraTest : public ::testing::Test {
     return frames;
   }
   std::optional<std::string> program_;
+  std::optional<test::FakeCameraLock> lock_;
 };
 
 // GigE Vision 1 block ids are 16 bits, counting 1..65535 and wrapping.
@@ -159,6 +161,20 @@ TEST_F(FakeCameraTest, AnUnsupportedPixelFormatIsNamed) {
     EXPECT_NE(std::string(e.what()).find("Mono16"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find(fake->serial()), std::string::npos) << e.what();
   }
+}
+
+// A camera another client controls cannot stream: the second opener is told so, by name.
+TEST_F(FakeCameraTest, ACameraControlledElsewhereIsReported) {
+  const auto fake = start();
+  Camera first(mono8(fake->serial(), 25));
+  try {
+    Camera second(mono8(fake->serial(), 25));
+    FAIL() << "two controllers of one camera";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("cannot take control"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find(fake->serial()), std::string::npos) << e.what();
+  }
+  EXPECT_TRUE(first.next(2s)) << "the first controller keeps streaming";
 }
 
 // Filling frames with a test's own pixels is for Aravis' in-process fake camera only.

@@ -5,6 +5,7 @@
 
 #include <fcntl.h>
 #include <signal.h>
+#include <sys/file.h>
 #include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -14,6 +15,7 @@
 #include <filesystem>
 #include <optional>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <thread>
 #include <vector>
@@ -34,6 +36,32 @@ inline std::optional<std::string> fake_camera_program() {
   }
   return std::nullopt;
 }
+
+// The fake camera's control port (UDP 3956 on 127.0.0.1) admits one camera per host, and other
+// test runs on the same machine (other build folders, other checkouts) start theirs too: a test
+// holds this host-wide lock for its whole length. flock is released when the process ends, however
+// it ends.
+class FakeCameraLock {
+ public:
+  explicit FakeCameraLock(std::chrono::seconds timeout = std::chrono::seconds(150)) {
+    fd_ = open("/tmp/mocap-arv-fake-gv-camera.lock", O_RDWR | O_CREAT | O_CLOEXEC, 0666);
+    if (fd_ < 0) throw std::runtime_error("cannot open the fake camera lock file");
+    const auto deadline = std::chrono::steady_clock::now() + timeout;
+    while (flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+      if (std::chrono::steady_clock::now() > deadline) {
+        close(fd_);
+        throw std::runtime_error("another test run kept the fake camera for too long");
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    }
+  }
+  ~FakeCameraLock() { close(fd_); }
+  FakeCameraLock(const FakeCameraLock&) = delete;
+  FakeCameraLock& operator=(const FakeCameraLock&) = delete;
+
+ private:
+  int fd_ = -1;
+};
 
 class FakeGvCamera {
  public:
