@@ -131,7 +131,8 @@ TEST(Process, SigtermMidRunFlushesTheSinksAndExitsZero) {
           " } }\n"
           "edges:\n  - [src.out, slow.in, { policy: blocking(100) }]\n  - [slow.out, sink.in]\n");
   Mocap run(dir, "run", {"run", graph});
-  std::this_thread::sleep_for(700ms);
+  ASSERT_TRUE(run.wait_until_blocking(SIGTERM, 30s)) << run.err();
+  std::this_thread::sleep_for(500ms);  // messages flow
   kill(run.pid(), SIGTERM);
   ASSERT_EQ(run.wait(30s), 0) << run.err();
   EXPECT_NE(run.err().find("stopping: draining"), std::string::npos) << run.err();

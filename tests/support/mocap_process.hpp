@@ -75,6 +75,21 @@ class Mocap {
     }
     return std::nullopt;
   }
+  // Waits until the process has `signal` blocked (the graph's signal watcher takes stop signals
+  // with sigtimedwait): a signal sent before that would kill it with the default action.
+  bool wait_until_blocking(int signal, std::chrono::milliseconds timeout) const {
+    const auto deadline = std::chrono::steady_clock::now() + timeout;
+    const std::string status = "/proc/" + std::to_string(pid_) + "/status";
+    while (std::chrono::steady_clock::now() < deadline) {
+      for (const std::string& line : read_lines(status)) {
+        if (line.rfind("SigBlk:", 0) != 0) continue;
+        const unsigned long long mask = std::stoull(line.substr(7), nullptr, 16);
+        if (mask & (1ull << (signal - 1))) return true;
+      }
+      std::this_thread::sleep_for(10ms);
+    }
+    return false;
+  }
   std::string err() const { return read_file(err_); }
   std::string out() const { return read_file(out_); }
   // Waits until stderr matches `pattern`; returns the first capture group (or "").
