@@ -64,18 +64,14 @@ bool wait_until(const std::function<bool()>& done, std::chrono::milliseconds tim
   return true;
 }
 
-class AravisSourceTest : public ::testing::Test {
+class AravisSourceTest : public test::FakeCameraFixture {
  protected:
   void SetUp() override {
-    program_ = test::fake_camera_program();
-    if (!program_)
-      GTEST_SKIP() << test::kFakeCameraProgram << " not on PATH (package aravis-tools)";
-    lock_.emplace();  // see FakeCameraLock
+    FakeCameraFixture::SetUp();
+    if (IsSkipped()) return;
     const std::lock_guard lock(seen_mutex);
     seen.clear();
   }
-  std::optional<std::string> program_;
-  std::optional<test::FakeCameraLock> lock_;
 };
 
 TEST_F(AravisSourceTest, EmitsFramesWithHeaders) {

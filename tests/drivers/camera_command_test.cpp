@@ -13,15 +13,8 @@ namespace {
 
 using namespace std::chrono_literals;
 
-class CameraCommandTest : public ::testing::Test {
+class CameraCommandTest : public FakeCameraFixture {
  protected:
-  void SetUp() override {
-    program_ = fake_camera_program();
-    if (!program_) GTEST_SKIP() << kFakeCameraProgram << " not on PATH (package aravis-tools)";
-    lock_.emplace();  // see FakeCameraLock
-  }
-  std::optional<std::string> program_;
-  std::optional<FakeCameraLock> lock_;
   TempDir dir_;
 };
 

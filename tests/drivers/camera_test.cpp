@@ -16,14 +16,8 @@ namespace {
 using namespace std::chrono_literals;
 using test::FakeGvCamera;
 
-class FakeCameraTest : public ::testing::Test {
+class FakeCameraTest : public test::FakeCameraFixture {
  protected:
-  void SetUp() override {
-    program_ = test::fake_camera_program();
-    if (!program_)
-      GTEST_SKIP() << test::kFakeCameraProgram << " not on PATH (package aravis-tools)";
-    lock_.emplace();  // see FakeCameraLock
-  }
   std::unique_ptr<FakeGvCamera> start(int loss_per_thousand = 0) {
     return std::make_unique<FakeGvCamera>(*program_, test::unique_serial("MOCAP"),
                                           loss_per_thousand);
@@ -43,8 +37,6 @@ class FakeCameraTest : public ::testing::Test {
     }
     return frames;
   }
-  std::optional<std::string> program_;
-  std::optional<test::FakeCameraLock> lock_;
 };
 
 // GigE Vision 1 block ids are 16 bits, counting 1..65535 and wrapping.

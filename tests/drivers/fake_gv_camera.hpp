@@ -20,6 +20,8 @@
 #include <thread>
 #include <vector>
 
+#include <gtest/gtest.h>
+
 #include "camera.hpp"
 
 namespace mocap::test {
@@ -126,5 +128,18 @@ class FakeGvCamera {
 inline std::string unique_serial(const std::string& prefix) {
   return prefix + std::to_string(getpid());
 }
+
+// Base of every test that runs the fake GigE camera program: skips, saying why, when it is not
+// installed, and holds the host-wide FakeCameraLock for the test's duration.
+class FakeCameraFixture : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    program_ = fake_camera_program();
+    if (!program_) GTEST_SKIP() << kFakeCameraProgram << " not on PATH (package aravis-tools)";
+    lock_.emplace();
+  }
+  std::optional<std::string> program_;
+  std::optional<FakeCameraLock> lock_;
+};
 
 }  // namespace mocap::test
