@@ -1,0 +1,154 @@
+// source.video in a graph: offline it sends every frame stamped with its time in the video;
+// live it replays a file at the file's rate with wall-clock capture times and skips frames a
+// slow consumer made late (counted); a truncated video and an absent camera stop the graph with
+// an error naming the node and the input.
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <filesystem>
+#include <mutex>
+#include <vector>
+
+#include "graph/registry.hpp"
+#include "graph/transport.hpp"
+#include "sink_test_util.hpp"
+#include "support/files.hpp"
+
+namespace mocap::nodes {
+namespace {
+
+using namespace mocap::graph;
+namespace fs = std::filesystem;
+
+const std::string kVtestPart = "../shared/data/eval/opencv_samples/vtest_part0.avi";
+const std::string kStreetVideo = "../shared/data/eval/openpose_examples_media/video.avi";
+
+struct Seen {
+  Header header;
+  int width = 0, height = 0;
+  std::int64_t received_ns = 0;
+};
+std::mutex seen_mutex;
+std::vector<Seen> seen;
+
+// unit.capture_frames: keeps the headers and sizes of the frames it receives; `delay_ms` makes
+// it a slow consumer.
+class CaptureFrames : public Node {
+ public:
+  static void contract(Contract& c) {
+    c.input<VideoFrame>("in");
+    c.param<int>("delay_ms", 0, "time spent per frame", {0, 10000});
+  }
+  void open(Context& ctx) override { delay_ms_ = ctx.param<int>("delay_ms"); }
+  void process(Context& ctx) override {
+    const VideoFrame& frame = ctx.input<VideoFrame>("in");
+    {
+      const std::lock_guard lock(seen_mutex);
+      seen.push_back({frame.header, frame.image.width(), frame.image.height(), realtime_ns()});
+    }
+    if (delay_ms_ > 0) ctx.sleep_for(std::chrono::milliseconds(delay_ms_));
+  }
+
+ private:
+  int delay_ms_ = 0;
+};
+MOCAP_REGISTER_NODE("unit.capture_frames", CaptureFrames)
+
+std::string graph_yaml(const std::string& source_params, const std::string& edge = "",
+                       int delay_ms = 0) {
+  return "nodes:\n  src: { type: source.video, params: { " + source_params +
+         " } }\n  out: { type: unit.capture_frames, params: { delay_ms: " +
+         std::to_string(delay_ms) + " } }\nedges:\n  - [src.frames, out.in" + edge + "]\n";
+}
+
+TEST(VideoSourceNode, OfflineSendsEveryFrameStampedWithItsTimeInTheVideo) {
+  if (!fs::exists(kVtestPart)) GTEST_SKIP() << "shared video absent: " << kVtestPart;
+  seen.clear();
+  const RunResult result =
+      testing::run_graph(graph_yaml("path: " + kVtestPart + ", mode: offline"));
+  ASSERT_TRUE(result.ok) << result.error;
+  ASSERT_EQ(seen.size(), 200u);
+  for (std::size_t i = 0; i < seen.size(); ++i) {
+    EXPECT_EQ(seen[i].header.seq, i);
+    EXPECT_EQ(seen[i].header.frame, static_cast<std::int64_t>(i));
+    EXPECT_NEAR(static_cast<double>(seen[i].header.capture_ns) * 1e-9, 0.1 * i, 0.011);
+    EXPECT_EQ(seen[i].width, 768);
+    EXPECT_EQ(seen[i].height, 576);
+  }
+  EXPECT_EQ(testing::stats_of(result, "src").drops, 0u);
+}
+
+TEST(VideoSourceNode, LiveReplaysAFileAtItsRateWithWallClockCaptureTimes) {
+  if (!fs::exists(kStreetVideo)) GTEST_SKIP() << "shared video absent: " << kStreetVideo;
+  seen.clear();
+  const auto started = std::chrono::steady_clock::now();
+  const RunResult result =
+      testing::run_graph(graph_yaml("path: " + kStreetVideo + ", mode: live, count: 25"));
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  ASSERT_TRUE(result.ok) << result.error;
+  ASSERT_GE(seen.size(), 20u);  // a loaded machine may skip a few
+  EXPECT_GT(seconds, 0.45);     // 25 frames at 50 fps: paced, not as fast as possible
+  const std::int64_t now = realtime_ns();
+  for (std::size_t i = 1; i < seen.size(); ++i) {
+    const Seen& a = seen[i - 1];
+    const Seen& b = seen[i];
+    EXPECT_GT(b.header.capture_ns, a.header.capture_ns);
+    // Capture time is the frame's due time: its index at 50 fps after the first.
+    const double gap_s = static_cast<double>(b.header.capture_ns - a.header.capture_ns) * 1e-9;
+    EXPECT_NEAR(gap_s, 0.02 * static_cast<double>(b.header.frame - a.header.frame), 0.002);
+    EXPECT_LE(b.header.capture_ns, b.received_ns);
+    EXPECT_LT(now - b.header.capture_ns, 5'000'000'000);  // wall clock, not time in the video
+  }
+}
+
+TEST(VideoSourceNode, LiveSkipsFramesASlowConsumerMadeLateAndCountsThem) {
+  if (!fs::exists(kStreetVideo)) GTEST_SKIP() << "shared video absent: " << kStreetVideo;
+  seen.clear();
+  // The consumer takes 100 ms per frame behind a blocking edge of one slot: the source, held
+  // back, finds its frames overdue and skips them; the consumer stays near the present.
+  const RunResult result = testing::run_graph(graph_yaml(
+      "path: " + kStreetVideo + ", mode: live, count: 10", ", { policy: \"blocking(1)\" }", 100));
+  ASSERT_TRUE(result.ok) << result.error;
+  ASSERT_EQ(seen.size(), 10u);
+  EXPECT_GT(testing::stats_of(result, "src").drops, 20u);
+  EXPECT_GT(seen.back().header.frame, 30);  // about 5 frames skipped per frame taken
+  for (const Seen& s : seen) {
+    EXPECT_LT(s.received_ns - s.header.capture_ns, 250'000'000)  // latency does not build up
+        << "frame " << s.header.frame;
+  }
+}
+
+TEST(VideoSourceNode, ATruncatedVideoStopsTheGraphNamingTheNodeAndTheFile) {
+  if (!fs::exists(kVtestPart)) GTEST_SKIP() << "shared video absent: " << kVtestPart;
+  const test::TempDir dir;
+  const std::string copy = dir.file("cut.avi");
+  const std::string bytes = test::read_file(kVtestPart);
+  test::write_file(copy, bytes.substr(0, bytes.size() / 3));
+  seen.clear();
+  const RunResult result = testing::run_graph(graph_yaml("path: " + copy));
+  ASSERT_FALSE(result.ok);
+  EXPECT_NE(result.error.find("'src'"), std::string::npos) << result.error;
+  EXPECT_NE(result.error.find(copy), std::string::npos) << result.error;
+  EXPECT_NE(result.error.find("truncated"), std::string::npos) << result.error;
+  EXPECT_GT(seen.size(), 10u);  // the frames before the cut went through
+}
+
+TEST(VideoSourceNode, AnAbsentCameraStopsTheGraphWithAClearError) {
+  if (fs::exists("/dev/video9")) GTEST_SKIP() << "/dev/video9 exists on this machine";
+  const RunResult result = testing::run_graph(graph_yaml("path: /dev/video9"));
+  ASSERT_FALSE(result.ok);
+  EXPECT_NE(result.error.find("/dev/video9"), std::string::npos) << result.error;
+  EXPECT_NE(result.error.find("no such camera device"), std::string::npos) << result.error;
+}
+
+TEST(VideoSourceNode, RefusesAnUnknownMode) {
+  if (!fs::exists(kVtestPart)) GTEST_SKIP() << "shared video absent: " << kVtestPart;
+  const RunResult result = testing::run_graph(graph_yaml("path: " + kVtestPart + ", mode: fast"));
+  ASSERT_FALSE(result.ok);
+  EXPECT_NE(result.error.find("offline, live or auto"), std::string::npos) << result.error;
+}
+
+}  // namespace
+}  // namespace mocap::nodes
