@@ -1,8 +1,10 @@
 #include "graph_runner.hpp"
 
+#include <condition_variable>
 #include <cstdlib>
 #include <iostream>
 #include <mutex>
+#include <thread>
 
 #include "graph/signals.hpp"
 
@@ -32,7 +34,8 @@ class StopRelay {
 }  // namespace
 
 graph::RunResult run_graph_here(const graph::ResolvedGraph& graph, graph::RunOptions options,
-                                const std::string& label) {
+                                const std::string& label, const ProgressCallback& progress,
+                                std::chrono::milliseconds every) {
   StopRelay relay;
   graph::SignalWatcher watcher([&](int, int count) {
     if (count > 1) {
@@ -44,7 +47,25 @@ graph::RunResult run_graph_here(const graph::ResolvedGraph& graph, graph::RunOpt
   });
   graph::Runtime runtime(graph, std::move(options));
   relay.attach(&runtime);
+  std::mutex done_mutex;
+  std::condition_variable done_changed;
+  bool done = false;
+  std::thread reporter;
+  if (progress) {
+    reporter = std::thread([&] {
+      std::unique_lock lock(done_mutex);
+      while (!done_changed.wait_for(lock, every, [&] { return done; })) progress(runtime.stats());
+    });
+  }
   graph::RunResult result = runtime.run();
+  if (reporter.joinable()) {
+    {
+      const std::lock_guard lock(done_mutex);
+      done = true;
+    }
+    done_changed.notify_all();
+    reporter.join();
+  }
   relay.attach(nullptr);
   return result;
 }

@@ -1,9 +1,11 @@
-// `mocap reconstruct INPUT --db DB --out DIR`: runs the monocular graph
-// (graphs/monocular_json.yaml) on a folder of OpenPose JSON and writes poses.jsonl, one BVH per
-// person and summary.json.
+// `mocap reconstruct INPUT --db DB --out DIR`: runs the monocular graph on a folder of OpenPose
+// JSON (graphs/monocular_json.yaml) or on a video, camera, stream or image folder
+// (graphs/monocular_video.yaml: MoveNet finds the people) and writes poses.jsonl, one BVH per
+// person, overlay.mp4 and summary.json.
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <climits>
 #include <filesystem>
@@ -11,17 +13,21 @@
 #include <iomanip>
 #include <iostream>
 #include <map>
+#include <sstream>
 
 #include <nlohmann/json.hpp>
 
 #include "cli_args.hpp"
 #include "commands.hpp"
 #include "core/input_error.hpp"
+#include "detect/model_files.hpp"
 #include "eval_report.hpp"
 #include "graph/graph_spec.hpp"
 #include "graph/plugins.hpp"
 #include "graph/validation.hpp"
 #include "graph_runner.hpp"
+#include "progress_bar.hpp"
+#include "video/video_source.hpp"
 
 namespace mocap::cli {
 namespace {
@@ -53,10 +59,80 @@ void set_param(graph::GraphSpec& spec, std::string_view type, const std::string&
   }
 }
 
+// What the input is: a folder of OpenPose JSON, or anything source.video reads (a video file, a
+// camera device, a stream URL, a folder of images).
+enum class InputKind { openpose_json, video };
+
+InputKind input_kind(const std::string& input) {
+  std::error_code ec;
+  if (fs::is_directory(input, ec)) {
+    bool images = false;
+    for (const auto& e : fs::directory_iterator(input, ec)) {
+      const std::string name = e.path().filename().string();
+      if (name.ends_with("_keypoints.json")) return InputKind::openpose_json;
+      images = images || video::is_image_file_name(name);
+    }
+    if (images) return InputKind::video;
+    throw InputError(input,
+                     "neither OpenPose *_keypoints.json files nor images (.png, .jpg, ...) here");
+  }
+  if (video::classify(input) == video::SourceKind::file && !fs::exists(input, ec))
+    throw InputError(input, "no such file or folder");
+  return InputKind::video;
+}
+
+// The video's geometry and rate, read by opening it (closed again before the graph opens it).
+struct VideoInfo {
+  int width = 0, height = 0;
+  double fps = 0.0;
+  std::int64_t frames = -1;
+  bool live = false;
+};
+
+VideoInfo probe_video(const Args& args) {
+  video::SourceOptions options;
+  if (args.has("fps")) options.folder_fps = std::stod(args.get("fps"));
+  const video::VideoSource source(args.positionals()[0], options);
+  return {source.width(), source.height(), source.fps(), source.frame_count(), source.live()};
+}
+
+std::string number(double value) {
+  std::ostringstream out;
+  out << value;
+  return out.str();
+}
+
+void configure_video(graph::GraphSpec& spec, const Args& args, const VideoInfo& info) {
+  set_param(spec, "source.video", "path", args.positionals()[0]);
+  set_param(spec, "source.video", "decoder_threads", args.get("decoder-threads"));
+  if (args.has("fps")) set_param(spec, "source.video", "fps", args.get("fps"));
+  set_param(spec, "detect.movenet", "input_size", args.get("detector-size"));
+  set_param(spec, "detect.movenet", "threads", args.get("detector-threads"));
+  const double fps = args.has("fps") ? std::stod(args.get("fps")) : info.fps > 0 ? info.fps : 30.0;
+  for (const char* type : {"sink.bvh", "sink.overlay"}) set_param(spec, type, "fps", number(fps));
+  const std::string width = std::to_string(info.width), height = std::to_string(info.height);
+  set_param(spec, "recon.temporal_selector", "image_width", width);
+  set_param(spec, "recon.temporal_selector", "image_height", height);
+  set_param(spec, "recon.temporal_selector", "hfov_deg", args.get("hfov"));
+  set_param(spec, "sink.overlay", "canvas_width", width);
+  set_param(spec, "sink.overlay", "canvas_height", height);
+}
+
+// A graph with a MoveNet node on the cached model: a missing model is reported before anything
+// runs, naming the command that fetches it.
+void check_detector_model(const graph::GraphSpec& spec) {
+  for (const auto& node : spec.nodes) {
+    if (node.type != "detect.movenet") continue;
+    const auto model = node.params.find("model");
+    if (model == node.params.end() || model->second.text.empty()) detect::movenet_model_json();
+  }
+}
+
 void configure(graph::GraphSpec& spec, const Args& args, const fs::path& out) {
   set_param(spec, "source.openpose_json", "path", args.positionals()[0]);
+  const std::string fps = args.has("fps") ? args.get("fps") : "30";
   for (const char* type : {"source.openpose_json", "sink.bvh", "sink.overlay"})
-    set_param(spec, type, "fps", args.get("fps"));
+    set_param(spec, type, "fps", fps);
   for (const char* type :
        {"recon.scaler", "recon.matcher", "recon.temporal_selector", "sink.bvh"}) {
     set_param(spec, type, "db", args.get("db"));
@@ -116,24 +192,35 @@ json node_latency(const graph::GraphStats& stats) {
 int reconstruct_command(int argc, char** argv) {
   Args args(
       "mocap reconstruct INPUT --out DIR [--db DB] [options]",
-      "Reconstructs the 3D motion of every person in a folder of OpenPose *_keypoints.json files\n"
-      "(BODY_25, BODY_25B, COCO-18). Writes into DIR: poses.jsonl (one line per input frame: 15 "
-      "joints\n"
-      "per person, metres, camera coordinates, root-relative), person_<id>.bvh per person (when "
-      "the\n"
-      "graph has a sink.bvh) and summary.json.");
-  args.positional("INPUT", "folder of OpenPose *_keypoints.json files")
+      "Reconstructs the 3D motion of every person in a video file, camera device (/dev/videoN),\n"
+      "RTSP/HTTP stream or folder of images (people found by MoveNet), or in a folder of OpenPose\n"
+      "*_keypoints.json files (BODY_25, BODY_25B, COCO-18). Writes into DIR: poses.jsonl (one "
+      "line\n"
+      "per input frame: 15 joints per person, metres, camera coordinates, root-relative),\n"
+      "person_<id>.bvh per person, overlay.mp4 (the input beside the 3D skeletons) and "
+      "summary.json.");
+  args.positional("INPUT",
+                  "video file, /dev/videoN, rtsp:// or http:// URL, image folder, or "
+                  "folder of OpenPose *_keypoints.json files")
       .option("out", "DIR", "output folder (created)")
       .option("db", "FILE", "pose database", default_database())
-      .option("fps", "N", "frame rate of the keypoints' video", "30")
+      .option("fps", "N",
+              "frame rate (OpenPose JSON and image folders: 30 when absent; videos: their own)")
+      .option("detector-size", "N",
+              "video: MoveNet input size, a multiple of 32 (256 fast, 384-512 for small people)",
+              "256")
+      .option("detector-threads", "N", "video: detector threads (0: OpenCV's default)", "0")
+      .option("decoder-threads", "N",
+              "video: FFmpeg decoding threads (0: one per core; needs OpenCV >= 4.7)", "0")
       .option("image-size", "WxH",
-              "size of the images the keypoints came from; turns each pose onto its camera ray "
-              "(off when absent)")
+              "OpenPose JSON: size of the images the keypoints came from; turns each pose onto "
+              "its camera ray (off when absent; videos: always on, their own size)")
       .option("hfov", "DEG", "horizontal field of view assumed with --image-size", "60")
       .option("mode", "NAME",
               "temporal selection: path (Viterbi, lag 8), greedy (the paper) or nearest", "path")
-      .option("graph", "FILE", "graph to run",
-              (install_root() / "graphs" / "monocular_json.yaml").string())
+      .option("graph", "FILE",
+              "graph to run (default: graphs/monocular_json.yaml for OpenPose JSON, "
+              "graphs/monocular_video.yaml otherwise)")
       .option("set", "NODE.PARAM=VALUE", "override a node parameter of the graph", std::nullopt,
               true)
       .flag("quiet", "do not print statistics");
@@ -146,21 +233,40 @@ int reconstruct_command(int argc, char** argv) {
                      "../shared/data/mocap/cmu31 --split train --out " +
                          args.get("db") + "'");
   }
-  if (!fs::is_directory(args.positionals()[0]))
-    throw InputError(args.positionals()[0], "not a folder of OpenPose JSON files");
+  const InputKind kind = input_kind(args.positionals()[0]);
+  const VideoInfo info = kind == InputKind::video ? probe_video(args) : VideoInfo{};
   const fs::path out = args.get("out");
   fs::create_directories(out);
 
   graph::load_plugins_from_environment();
-  graph::GraphSpec spec = graph::load_graph_file(args.get("graph"));
+  const std::string graph_file =
+      args.has("graph")
+          ? args.get("graph")
+          : (install_root() / "graphs" /
+             (kind == InputKind::video ? "monocular_video.yaml" : "monocular_json.yaml"))
+                .string();
+  graph::GraphSpec spec = graph::load_graph_file(graph_file);
   configure(spec, args, out);
+  if (kind == InputKind::video) configure_video(spec, args, info);
   graph::apply_overrides(spec, args.all("set"));
+  check_detector_model(spec);
   const graph::ResolvedGraph resolved = graph::resolve(std::move(spec));
 
   const auto started = std::chrono::steady_clock::now();
   graph::RunOptions options;
   options.single_process = true;
-  const graph::RunResult result = run_graph_here(resolved, options, "mocap reconstruct");
+  ProgressBar bar(!args.has("quiet") && isatty(STDERR_FILENO) != 0);
+  ProgressCallback progress;
+  if (info.frames > 0) {
+    progress = [&](const graph::GraphStats& stats) {
+      for (const auto& n : stats.nodes) {
+        if (n.type == "sink.jsonl")
+          bar.update("reconstruct", static_cast<double>(n.in) / static_cast<double>(info.frames));
+      }
+    };
+  }
+  const graph::RunResult result = run_graph_here(resolved, options, "mocap reconstruct", progress);
+  bar.finish();
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   if (!args.has("quiet")) std::cerr << graph::format_stats_table(result.stats);
@@ -169,6 +275,12 @@ int reconstruct_command(int argc, char** argv) {
   summary["input"] = args.positionals()[0];
   summary["database"] = args.get("db");
   summary["mode"] = args.get("mode");
+  summary["graph"] = graph_file;
+  if (kind == InputKind::video) {
+    summary["detector_size"] = std::stoi(args.get("detector-size"));
+    summary["video"] = {
+        {"width", info.width}, {"height", info.height}, {"fps", info.fps}, {"frames", info.frames}};
+  }
   summary["seconds"] = seconds;
   summary["frames_per_second"] = seconds > 0 ? summary["frames"].get<double>() / seconds : 0.0;
   summary["id_switches"] =
@@ -183,10 +295,15 @@ int reconstruct_command(int argc, char** argv) {
             << summary["tracks_longer_than_50_frames"] << " tracks longer than 50 frames), "
             << std::fixed << std::setprecision(1) << summary["frames_per_second"].get<double>()
             << " frames/s\n";
+  std::vector<std::string> written;
   for (const auto& e : fs::directory_iterator(out)) {
     if (e.path().extension() == ".bvh" || e.path().extension() == ".mp4")
-      std::cout << "wrote " << e.path().string() << "\n";
+      written.push_back(e.path().string());
   }
+  std::sort(written.begin(), written.end(), [](const std::string& a, const std::string& b) {
+    return a.size() != b.size() ? a.size() < b.size() : a < b;  // person_2 before person_10
+  });
+  for (const std::string& file : written) std::cout << "wrote " << file << "\n";
   std::cout << "wrote " << (out / "summary.json").string() << "\n";
   if (!result.ok) {
     std::cerr << "mocap reconstruct: " << result.error << "\n";
