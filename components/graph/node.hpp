@@ -73,6 +73,10 @@ class Context {
   }
   // Counts a message this node chose to discard (flow limiters); shown with the edge drops.
   virtual void count_drop() = 0;
+  // Replaces the node's status line in the graph's statistics (GraphStats, the table printed at
+  // the end): events a user should see while the graph runs, e.g. a camera lost and reconnected
+  // or messages rejected. Nodes still print to stderr as before; this does not.
+  virtual void report_status(std::string text) { static_cast<void>(text); }
 
   // --- sources
   virtual void finish() = 0;  // no more messages: EndOfStream follows on every output

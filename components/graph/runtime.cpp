@@ -177,6 +177,10 @@ class NodeRunner final : public Context {
     s.max_queue_depth = inbox_.max_depth();
     static constexpr const char* kStates[] = {"waiting", "running", "done", "failed"};
     s.state = kStates[state_.load()];
+    {
+      const std::lock_guard lock(status_mutex_);
+      s.status = status_;
+    }
     return s;
   }
 
@@ -196,6 +200,10 @@ class NodeRunner final : public Context {
   const Header* input_header() const override { return current_ ? &current_->header() : nullptr; }
   void send_packet(std::string_view port, Packet packet) override;
   void count_drop() override { ++own_drops_; }
+  void report_status(std::string text) override {
+    const std::lock_guard lock(status_mutex_);  // snapshots are taken on other threads
+    status_ = std::move(text);
+  }
   void finish() override { finished_ = true; }
   bool stop_requested() const override {
     return runtime_.stop_requested() || (contract_.auxiliary() && runtime_.auxiliary_released());
@@ -250,6 +258,8 @@ class NodeRunner final : public Context {
   std::atomic<int> state_{waiting};
   std::atomic<bool> thread_finished_{false};
   LatencyWindow latency_;
+  mutable std::mutex status_mutex_;
+  std::string status_;
 };
 
 void NodeRunner::send_packet(std::string_view port, Packet packet) {

@@ -46,6 +46,7 @@ std::string format_stats_table(const GraphStats& stats) {
                   static_cast<unsigned long long>(n.out), static_cast<unsigned long long>(n.drops),
                   n.p50_us, n.p95_us, n.queue_depth, n.max_queue_depth, n.state.c_str());
     out << line;
+    if (!n.status.empty()) out << "  " << n.node << ": " << n.status << "\n";
   }
   return out.str();
 }

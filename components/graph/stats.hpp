@@ -19,7 +19,8 @@ struct NodeStats {
   std::uint64_t in = 0, out = 0, drops = 0;
   double p50_us = 0, p95_us = 0;  // time spent in process(), over the last samples
   std::size_t queue_depth = 0, max_queue_depth = 0;
-  std::string state;  // "running", "done", "failed"
+  std::string state;   // "running", "done", "failed"
+  std::string status;  // the node's latest status line (Context::report_status), e.g. a reconnect
 
   bool operator==(const NodeStats&) const = default;
 };

@@ -50,6 +50,12 @@ void configure(zmq::socket_t& socket, const SocketOptions& options) {
   socket.set(zmq::sockopt::maxmsgsize, options.max_message_bytes);
 }
 
+// ZeroMQ's "Peer-Address" message property: the sender's IP for tcp, empty where unknown.
+std::string peer_address(zmq::message_t& message) {
+  const char* address = zmq_msg_gets(message.handle(), "Peer-Address");
+  return address ? address : "";
+}
+
 std::runtime_error endpoint_error(const std::string& what, const std::string& endpoint,
                                   const zmq::error_t& e) {
   return std::runtime_error("cannot " + what + " " + endpoint + ": " + e.what());
@@ -131,15 +137,21 @@ struct Receiver::Impl {
   zmq::socket_t socket;
 };
 
-Receiver::Receiver(TransportContext& context, const std::string& endpoint, SocketOptions options)
+Receiver::Receiver(TransportContext& context, const std::string& endpoint, SocketOptions options,
+                   Pattern pattern)
     : endpoint_(endpoint) {
-  impl_ =
-      std::make_unique<Impl>(Impl{zmq::socket_t(context.impl().context, zmq::socket_type::dealer)});
+  const auto type = pattern == Pattern::edge ? zmq::socket_type::dealer : zmq::socket_type::pull;
+  impl_ = std::make_unique<Impl>(Impl{zmq::socket_t(context.impl().context, type)});
   configure(impl_->socket, options);
+  const bool connect = pattern == Pattern::pull_connect;
   try {
-    impl_->socket.bind(endpoint);
+    if (connect) {
+      impl_->socket.connect(endpoint);
+    } else {
+      impl_->socket.bind(endpoint);
+    }
   } catch (const zmq::error_t& e) {
-    throw endpoint_error("bind", endpoint, e);
+    throw endpoint_error(connect ? "connect to" : "bind", endpoint, e);
   }
 }
 
@@ -158,22 +170,24 @@ Receiver::Result Receiver::receive(std::chrono::milliseconds timeout) {
   std::vector<wire::Frame> frames;
   std::size_t parts = 0;
   bool more = true;
+  std::string peer;
   while (more) {
     auto part = std::make_shared<zmq::message_t>();
     if (!impl_->socket.recv(*part)) break;
     more = part->more();
+    if (parts == 0) peer = peer_address(*part);
     if (++parts <= wire::kMaxFrames + 1) {
       frames.push_back(
           wire::Frame{static_cast<const std::byte*>(part->data()), part->size(), part});
     }
   }
   if (parts > wire::kMaxFrames + 1) {
-    return {std::nullopt, "too many frames (" + std::to_string(parts) + ")"};
+    return {std::nullopt, "too many frames (" + std::to_string(parts) + ")", peer};
   }
   try {
-    return {wire::decode(frames), {}};
+    return {wire::decode(frames), {}, peer};
   } catch (const wire::WireError& e) {
-    return {std::nullopt, e.what()};
+    return {std::nullopt, e.what(), peer};
   }
 }
 

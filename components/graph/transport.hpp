@@ -74,7 +74,13 @@ class Sender {
 
 class Receiver {
  public:
-  Receiver(TransportContext& context, const std::string& endpoint, SocketOptions options = {});
+  enum class Pattern {
+    edge,          // DEALER, binds: the consumer of a graph edge (acknowledges end of stream)
+    pull_bind,     // PULL, binds: any number of PUSH producers connect (other programs)
+    pull_connect,  // PULL, connects to one PUSH producer that binds
+  };
+  Receiver(TransportContext& context, const std::string& endpoint, SocketOptions options = {},
+           Pattern pattern = Pattern::edge);
   ~Receiver();
   Receiver(const Receiver&) = delete;
   Receiver& operator=(const Receiver&) = delete;
@@ -82,6 +88,7 @@ class Receiver {
   struct Result {
     std::optional<wire::Decoded> message;  // a valid message
     std::string rejected;                  // or why a malformed one was dropped
+    std::string peer;  // the sender's address where ZeroMQ knows it (tcp: its IP), else ""
   };
   // Waits up to `timeout`; both fields empty when nothing arrived.
   Result receive(std::chrono::milliseconds timeout);

@@ -196,7 +196,8 @@ std::vector<Frame> encode_stats(const GraphStats& m) {
                      {"p95_us", n.p95_us},
                      {"queue_depth", n.queue_depth},
                      {"max_queue_depth", n.max_queue_depth},
-                     {"state", n.state}});
+                     {"state", n.state},
+                     {"status", n.status}});
   }
   const std::string text = nlohmann::json{{"graph", m.graph}, {"nodes", nodes}}.dump();
   Writer json;
@@ -331,9 +332,11 @@ Packet decode_stats(const Header& header, std::span<const Frame> payload) {
                               reinterpret_cast<const char*>(payload[0].data) + payload[0].size);
     m->graph = json.at("graph").get<std::string>();
     for (const auto& n : json.at("nodes")) {
+      // "status" came later within version 1: a sender without it has no status to report.
       m->nodes.push_back(NodeStats{n.at("node"), n.at("type"), n.at("process"), n.at("in"),
                                    n.at("out"), n.at("drops"), n.at("p50_us"), n.at("p95_us"),
-                                   n.at("queue_depth"), n.at("max_queue_depth"), n.at("state")});
+                                   n.at("queue_depth"), n.at("max_queue_depth"), n.at("state"),
+                                   n.value("status", std::string())});
     }
   } catch (const nlohmann::json::exception& e) {
     throw WireError(std::string("GraphStats: ") + e.what());

@@ -149,7 +149,9 @@ TEST(WireFormat, VideoFrameTravelsWithoutCopies) {
 TEST(WireFormat, StatsAndEndOfStreamRoundTrip) {
   auto stats = std::make_shared<GraphStats>();
   stats->graph = "g";
-  stats->nodes.push_back(NodeStats{"a", "test.counter", "p", 1, 2, 3, 4.5, 6.5, 7, 8, "done"});
+  stats->nodes.push_back(NodeStats{"a", "test.counter", "p", 1, 2, 3, 4.5, 6.5, 7, 8, "done", ""});
+  stats->nodes.push_back(
+      NodeStats{"b", "source.aravis", "p", 0, 9, 1, 0, 0, 0, 0, "running", "reconnected (1)"});
   const Packet back = round_trip(Packet::of<GraphStats>(stats));
   EXPECT_EQ(static_cast<const GraphStats&>(*back.message).nodes, stats->nodes);
   EXPECT_TRUE(round_trip(Packet::end_of_stream(header(5))).is_end_of_stream());
