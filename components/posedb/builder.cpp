@@ -16,6 +16,7 @@
 #include "motion/asf_amc.hpp"
 #include "motion/body_mapping.hpp"
 #include "motion/bvh.hpp"
+#include "motion/canonical_body.hpp"
 #include "motion/pose_sequence.hpp"
 #include "posedb/kmeans.hpp"
 #include "posedb/projection.hpp"
@@ -114,8 +115,14 @@ void add_body_frame(std::array<glm::vec3, kBodyJoints> body, float& heading, Cli
       {0, static_cast<std::uint32_t>(out.frames.size()), heading, {root.x, root.y, root.z}});
 }
 
+// What the canonical body adds to a clip's mapping text.
+std::string canonical_note() {
+  return "; rescaled to the canonical body (" + motion::describe(motion::canonical_proportions()) +
+         "; bone directions kept, shoulders re-hung from the neck, hips symmetric about the root)";
+}
+
 void add_run(const motion::PoseSequence& poses, const motion::BodyMapping& mapping,
-             ClipFrames& out) {
+             BodyChoice choice, ClipFrames& out) {
   motion::GlobalPose global;
   float heading = 0.0f;
   const int joints = poses.joint_count();
@@ -123,6 +130,8 @@ void add_run(const motion::PoseSequence& poses, const motion::BodyMapping& mappi
     motion::forward_kinematics(poses, f, global);
     std::array<glm::vec3, kBodyJoints> body;
     motion::body_positions(mapping, global, body);
+    if (choice == BodyChoice::canonical)
+      body = motion::retarget(body, motion::canonical_proportions());
     add_body_frame(body, heading, out);
     for (int j = 0; j < joints; ++j) {
       const glm::quat q = poses.rotation[poses.at(f, j)];
@@ -148,11 +157,13 @@ std::vector<ClipFrames> read_clips(const std::string& file, const BuildOptions& 
     c.info.source = path.string();
     c.info.family = std::string(motion::family_name(mapping.family));
     c.info.mapping = mapping.notes;
+    if (options.body == BodyChoice::canonical) c.info.mapping += canonical_note();
     c.info.source_fps = clip.fps();
     c.info.source_first_frame = static_cast<std::uint32_t>(first);
     c.info.metres_per_unit = mapping.metres_per_unit;
     c.info.skeleton = clip.skeleton;
-    add_run(motion::resample(motion::slice(all, first, count), options.fps), mapping, c);
+    add_run(motion::resample(motion::slice(all, first, count), options.fps), mapping, options.body,
+            c);
     c.info.frame_count = static_cast<std::uint32_t>(c.frames.size());
     out.push_back(std::move(c));
   }
@@ -211,12 +222,16 @@ ClipFrames clip_from_bodies(const BodySequence& sequence, const BuildOptions& op
   c.info.source = sequence.source;
   c.info.family = sequence.family;
   c.info.mapping = sequence.mapping;
+  if (options.body == BodyChoice::canonical) c.info.mapping += canonical_note();
   c.info.source_fps = sequence.fps;
   float heading = 0.0f;
   for (const auto& body :
        motion::resample_points(std::span<const std::array<glm::vec3, kBodyJoints>>(sequence.frames),
                                sequence.fps, options.fps)) {
-    add_body_frame(body, heading, c);
+    add_body_frame(options.body == BodyChoice::canonical
+                       ? motion::retarget(body, motion::canonical_proportions())
+                       : body,
+                   heading, c);
   }
   c.info.frame_count = static_cast<std::uint32_t>(c.frames.size());
   return c;
@@ -350,6 +365,7 @@ DatabaseContents assemble(std::vector<ClipFrames>& clips, const BuildOptions& op
   cluster(options, db, progress);
   db.build.fps = options.fps;
   db.build.scaling = options.scaling;
+  db.build.body = options.body;
   db.build.views = options.views;
   db.build.clusters = static_cast<int>(db.cluster_begin.size()) - 1;
   db.build.seed = options.seed;

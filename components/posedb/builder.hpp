@@ -21,6 +21,10 @@ struct BuildOptions {
   double fps = 24.0;
   ViewSetOptions views;
   Scaling scaling = Scaling::bbox_height;
+  // source: every clip on its own skeleton's proportions; canonical: every frame's 15 joints
+  // rescaled to the canonical body (motion/canonical_body.hpp) before facing and projection.
+  // The source rotations are kept either way. `mocap db build` defaults to canonical.
+  BodyChoice body = BodyChoice::source;
   int clusters = 0;  // 0: about sqrt(projections), at least 16
   int kmeans_iterations = 8;
   std::size_t kmeans_sample = 200'000;

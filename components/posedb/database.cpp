@@ -13,6 +13,16 @@
 #include "posedb/database_format.hpp"
 
 namespace mocap::posedb {
+
+std::string_view body_choice_name(BodyChoice b) {
+  return b == BodyChoice::canonical ? "canonical" : "source";
+}
+
+bool parse_body_choice(std::string_view text, BodyChoice& out) {
+  if (text == "canonical") return out = BodyChoice::canonical, true;
+  if (text == "source") return out = BodyChoice::source, true;
+  return false;
+}
 namespace {
 
 // Owns one read-only mapping of a whole file.

@@ -8,6 +8,7 @@
 #include <memory>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "motion/skeleton.hpp"
@@ -48,9 +49,17 @@ struct ClipInfo {
   motion::Skeleton skeleton;  // source hierarchy, for BVH output
 };
 
+// Which body the database's joints and projections are on: the source skeletons' own
+// proportions, or every clip rescaled to the canonical body (motion/canonical_body.hpp).
+enum class BodyChoice { source, canonical };
+std::string_view body_choice_name(BodyChoice b);
+bool parse_body_choice(std::string_view text, BodyChoice& out);
+
 struct BuildInfo {
   double fps = 24.0;
   Scaling scaling = Scaling::bbox_height;
+  // Files written before the choice existed have no "body" entry: they are on the source body.
+  BodyChoice body = BodyChoice::source;
   ViewSetOptions views;
   int clusters = 0;
   std::uint64_t seed = 0;

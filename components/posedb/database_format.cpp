@@ -71,6 +71,7 @@ std::uint32_t crc32_of(const void* data, std::uint64_t size) {
 std::string build_info_to_json(const BuildInfo& b) {
   const json j = {{"fps", b.fps},
                   {"scaling", std::string(scaling_name(b.scaling))},
+                  {"body", std::string(body_choice_name(b.body))},
                   {"views",
                    {{"yaw_steps", b.views.yaw_steps},
                     {"heights_m", b.views.heights_m},
@@ -90,6 +91,8 @@ BuildInfo build_info_from_json(const std::string& text) {
   b.fps = j.at("fps").get<double>();
   if (!parse_scaling(j.at("scaling").get<std::string>(), b.scaling))
     throw std::runtime_error("unknown scaling");
+  if (j.contains("body") && !parse_body_choice(j.at("body").get<std::string>(), b.body))
+    throw std::runtime_error("unknown body '" + j.at("body").get<std::string>() + "'");
   const auto& v = j.at("views");
   b.views.yaw_steps = v.at("yaw_steps").get<int>();
   b.views.heights_m = v.at("heights_m").get<std::vector<float>>();

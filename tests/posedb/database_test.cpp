@@ -5,11 +5,15 @@
 #include <random>
 
 #include <gtest/gtest.h>
+#include <glm/geometric.hpp>
+#include <nlohmann/json.hpp>
 
 #include "core/input_error.hpp"
+#include "motion/canonical_body.hpp"
 #include "motion/cmu_asf_fixture.hpp"
 #include "posedb/builder.hpp"
 #include "posedb/cluster_search.hpp"
+#include "posedb/database_format.hpp"
 #include "posedb/exact_search.hpp"
 #include "support/shared_data.hpp"
 
@@ -191,6 +195,70 @@ TEST(DatabaseFiles, AsfAmcFolderBuilds) {
   EXPECT_EQ(db.clips[0].family, "cmu_asf");
   EXPECT_EQ(db.clips[0].frame_count, 48u);  // 240 frames at 120 fps -> 48 at 24 fps
   EXPECT_EQ(db.projection_records.size(), 48u * 120u);
+}
+
+}  // namespace
+}  // namespace mocap::posedb
+
+namespace mocap::posedb {
+namespace {
+
+// --body canonical: CMU and Bandai clips on one body, every bone at its canonical length, the
+// source rotations and frame bookkeeping as with --body source; the choice survives the file.
+TEST(CanonicalDatabase, EveryFamilyOnTheCanonicalBodyWithItsRotationsKept) {
+  const fs::path mocap = test::shared_data() / "mocap";
+  MOCAP_REQUIRE_SHARED("mocap/bandai/dataset-1/dataset-1_bow_normal_001.bvh");
+  const std::vector<std::string> files = {
+      (mocap / "cmu31/08_01.bvh").string(),
+      (mocap / "bandai/dataset-1/dataset-1_bow_normal_001.bvh").string()};
+  BuildOptions options;
+  options.clusters = 16;
+  options.views.yaw_steps = 4;
+  BuildReport report;
+  const DatabaseContents source = build_database(files, options, {}, report);
+  options.body = BodyChoice::canonical;
+  const DatabaseContents canonical = build_database(files, options, {}, report);
+  EXPECT_EQ(source.build.body, BodyChoice::source);
+  ASSERT_EQ(canonical.frames.size(), source.frames.size());
+  EXPECT_EQ(canonical.rotations, source.rotations);
+  const motion::BodyProportions& c = motion::canonical_proportions();
+  float bandai_source_shoulders = 0.0f;
+  for (std::size_t f = 0; f < canonical.frames.size(); ++f) {
+    motion::Body15 body, src;
+    for (int j = 0; j < kBodyJoints; ++j) {
+      const std::size_t at = (f * kBodyJoints + j) * 3;
+      body[j] = {canonical.joints[at], canonical.joints[at + 1], canonical.joints[at + 2]};
+      src[j] = {source.joints[at], source.joints[at + 1], source.joints[at + 2]};
+    }
+    const motion::BodyProportions got = motion::proportions_of(body);
+    for (int j = 0; j < kBodyJoints; ++j) ASSERT_NEAR(got.bone_m[j], c.bone_m[j], 1e-4f) << f;
+    if (canonical.frames[f].clip == 1)
+      bandai_source_shoulders =
+          glm::distance(src[index(Joint::left_shoulder)], src[index(Joint::right_shoulder)]);
+  }
+  EXPECT_LT(bandai_source_shoulders, 0.25f);  // the source body differs: Bandai's 205 mm
+  for (const auto& clip : canonical.clips)
+    EXPECT_NE(clip.mapping.find("canonical body"), std::string::npos) << clip.mapping;
+
+  test::TempDir dir;
+  write_database(canonical, dir.file("canonical.mdb"));
+  const Database db = Database::open(dir.file("canonical.mdb"));
+  EXPECT_EQ(db.build_info().body, BodyChoice::canonical);
+  EXPECT_EQ(db.clips()[1].family, "bandai");
+}
+
+// Files written before the body choice existed have no "body" entry: they are on the source
+// body. An unknown body name is refused.
+TEST(CanonicalDatabase, OptionsWithoutBodyReadAsSource) {
+  BuildInfo info;
+  info.body = BodyChoice::canonical;
+  nlohmann::json j = nlohmann::json::parse(format::build_info_to_json(info));
+  EXPECT_EQ(j.at("body"), "canonical");
+  EXPECT_EQ(format::build_info_from_json(j.dump()).body, BodyChoice::canonical);
+  j.erase("body");
+  EXPECT_EQ(format::build_info_from_json(j.dump()).body, BodyChoice::source);
+  j["body"] = "giant";
+  EXPECT_THROW(format::build_info_from_json(j.dump()), std::exception);
 }
 
 }  // namespace

@@ -46,22 +46,37 @@ std::string joined_command(const char* name, int argc, char** argv) {
   return s;
 }
 
-// Keeps the files that a folder's splits.txt ("train 01_01.bvh" lines) assigns to `split`.
-std::vector<std::string> filter_split(const std::vector<std::string>& inputs,
-                                      const std::vector<std::string>& files,
-                                      const std::string& split) {
-  std::map<std::string, std::string> split_of;
+// The motion files of the inputs for `split`: a folder with a splits.txt ("train 01_01.bvh"
+// lines) gives only the files it assigns to `split`; a folder without one (bandai/) and a file
+// named directly give all their files, said on stderr. At least one folder must have a
+// splits.txt.
+std::vector<std::string> files_of_split(const std::vector<std::string>& inputs,
+                                        const std::string& split) {
+  std::vector<std::string> kept;
+  bool any_list = false;
   for (const auto& in : inputs) {
+    const std::vector<std::string> files = posedb::collect_motion_files({in});
     std::ifstream list(std::filesystem::path(in) / "splits.txt");
+    if (!std::filesystem::is_directory(in) || !list) {
+      std::cerr << in << ": no splits.txt, all " << files.size() << " motion file(s) taken\n";
+      kept.insert(kept.end(), files.begin(), files.end());
+      continue;
+    }
+    any_list = true;
+    std::map<std::string, std::string> split_of;
     std::string which, file;
     while (list >> which >> file) split_of[file] = which;
+    std::size_t taken = 0;
+    for (const auto& f : files) {
+      const auto it = split_of.find(std::filesystem::path(f).filename().string());
+      if (it != split_of.end() && it->second == split) kept.push_back(f), ++taken;
+    }
+    std::cerr << in << ": " << taken << " of " << files.size() << " motion file(s) in split '"
+              << split << "'\n";
   }
-  if (split_of.empty()) throw InputError("--split", "no splits.txt found in the input folders");
-  std::vector<std::string> kept;
-  for (const auto& f : files) {
-    const auto it = split_of.find(std::filesystem::path(f).filename().string());
-    if (it != split_of.end() && it->second == split) kept.push_back(f);
-  }
+  if (!any_list) throw InputError("--split", "no splits.txt found in the input folders");
+  std::sort(kept.begin(), kept.end());
+  kept.erase(std::unique(kept.begin(), kept.end()), kept.end());
   if (kept.empty()) throw InputError("--split", "no file belongs to split '" + split + "'");
   return kept;
 }
@@ -81,10 +96,17 @@ int build(int argc, char** argv) {
       .option("distance", "M", "horizontal camera distance in metres", "4")
       .option("scaling", "MODE", "2D normalisation: bbox_height (paper) or bone_length",
               "bbox_height")
+      .option("body", "NAME",
+              "canonical: every family rescaled to one body (CMU-train median bones, bone "
+              "directions kept;\nsee docs/body15.md), source: each skeleton's own proportions",
+              "canonical")
       .option("clusters", "N", "k-means clusters (0 = about sqrt(projections))", "0")
       .option("seed", "N", "random seed for k-means", "1")
       .option("threads", "N", "worker threads", "2")
-      .option("split", "NAME", "only files a folder's splits.txt assigns to NAME (e.g. train)");
+      .option("split", "NAME",
+              "only the files a folder's splits.txt assigns to NAME (e.g. train); a folder "
+              "without\nsplits.txt (bandai/) is taken whole. Never give cmu_daz/ for a training "
+              "database:\nit holds the held-out subjects' trials");
   int code = 0;
   if (!args.parse(argc, argv, code)) return code;
   if (!args.has("out")) throw InputError("--out", "required: the database file to write");
@@ -98,13 +120,16 @@ int build(int argc, char** argv) {
     throw InputError("--scaling",
                      "expected bbox_height or bone_length, got '" + args.get("scaling") + "'");
   }
+  if (!posedb::parse_body_choice(args.get("body"), options.body))
+    throw InputError("--body", "expected canonical or source, got '" + args.get("body") + "'");
   options.clusters = static_cast<int>(args.integer("clusters"));
   options.seed = static_cast<std::uint64_t>(args.integer("seed"));
   options.threads = static_cast<int>(std::clamp(args.integer("threads"), 1L, 64L));
   options.command = joined_command("build", argc, argv);
 
-  std::vector<std::string> files = posedb::collect_motion_files(args.positionals());
-  if (args.has("split")) files = filter_split(args.positionals(), files, args.get("split"));
+  const std::vector<std::string> files = args.has("split")
+                                             ? files_of_split(args.positionals(), args.get("split"))
+                                             : posedb::collect_motion_files(args.positionals());
   if (files.empty()) throw InputError("", "no .bvh or .amc files in the given paths");
   std::cerr << "building from " << files.size() << " motion file(s)\n";
 
@@ -153,6 +178,7 @@ json info_json(const posedb::Database& db) {
           {"clusters", db.centroids().rows},
           {"largest_cluster", largest},
           {"index", "k-means clusters with representatives (rows stored grouped by cluster)"},
+          {"body", std::string(posedb::body_choice_name(db.build_info().body))},
           {"families", fam},
           {"build", json::parse(db.options_json())},
           {"clip_list", clips}};
@@ -181,15 +207,23 @@ int info(int argc, char** argv) {
             << b.views.heights_m.size() << " camera heights";
   for (float h : b.views.heights_m) std::cout << " " << h;
   std::cout << " m, " << b.views.distance_m << " m away)\n"
+            << "body         " << posedb::body_choice_name(b.body)
+            << (b.body == posedb::BodyChoice::canonical
+                    ? " (every clip rescaled to the canonical body)"
+                    : " (each clip on its source skeleton's proportions)")
+            << "\n"
             << "projections  " << db.projections().rows << " x " << db.projections().dim
             << " floats, " << posedb::scaling_name(b.scaling) << " normalisation\n"
             << "clusters     " << db.centroids().rows << " (largest " << j["largest_cluster"]
             << ")\n"
             << "index        " << j["index"].get<std::string>() << "\n"
-            << "families    ";
-  for (const auto& [name, f] : j["families"].items())
-    std::cout << " " << name << ": " << f["clips"] << " clips, " << f["frames"] << " frames;";
-  std::cout << "\nbuilt        " << b.created << " in " << b.build_seconds << " s, seed " << b.seed
+            << "families     " << j["families"].size() << "\n";
+  for (const auto& [name, f] : j["families"].items()) {
+    std::cout << "  " << std::left << std::setw(10) << name << std::right << " " << std::setw(5)
+              << f["clips"].get<int>() << " clips " << std::setw(8)
+              << f["frames"].get<std::uint64_t>() << " frames\n";
+  }
+  std::cout << "built        " << b.created << " in " << b.build_seconds << " s, seed " << b.seed
             << "\n"
             << "command      " << b.command << "\n";
   if (args.has("clips")) {
