@@ -6,6 +6,7 @@
 
 #include "posedb/cluster_search.hpp"
 #include "posedb/exact_search.hpp"
+#include "posedb/projection.hpp"
 
 namespace mocap::recon {
 
@@ -38,6 +39,32 @@ float partial_height(const float* row, const posedb::PoseVector& weights) {
     hi = std::max(hi, row[2 * j + 1]);
   }
   return hi - lo;
+}
+
+// The candidate's database pose retargeted to `person`, seen by its view and normalised as the
+// database's rows are; its squared distance to `query` over the weighted dimensions, or +inf when
+// the retargeted pose cannot be normalised.
+float person_distance(const posedb::Database& db, const Candidate& c,
+                      const motion::BodyProportions& person, const posedb::PoseVector& query,
+                      const posedb::PoseVector& weights) {
+  const auto j = db.joints(c.frame);
+  motion::Body15 body;
+  for (int b = 0; b < kBodyJoints; ++b) body[b] = {j[3 * b], j[3 * b + 1], j[3 * b + 2]};
+  body = motion::retarget(body, person);
+  const posedb::CameraPose camera =
+      posedb::camera_pose(db.views()[c.view], db.build_info().views.root_height_m);
+  std::array<glm::vec2, kBodyJoints> image;
+  posedb::project_body(body, camera, image);
+  posedb::PoseVector row;
+  if (!posedb::normalize_pose(image, db.build_info().scaling, row))
+    return std::numeric_limits<float>::infinity();
+  float sum = 0.0f;
+  for (int d = 0; d < posedb::kPoseDims; ++d) {
+    if (weights[d] == 0.0f) continue;
+    const float e = row[d] - query[d];
+    sum += weights[d] * e * e;
+  }
+  return std::isfinite(sum) ? sum : std::numeric_limits<float>::infinity();
 }
 
 }  // namespace
@@ -82,6 +109,12 @@ void Matcher::search(const posedb::PoseVector& normalized, std::vector<Candidate
   const auto records = db_.projection_records();
   for (const auto& n : found) {
     out.push_back({n.index, records[n.index].frame, records[n.index].view, n.distance});
+  }
+  if (person_) {
+    for (auto& c : out) c.distance = person_distance(db_, c, *person_, query, weights);
+    std::stable_sort(out.begin(), out.end(), [](const Candidate& a, const Candidate& b) {
+      return a.distance < b.distance;
+    });
   }
 }
 

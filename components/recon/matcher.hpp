@@ -6,11 +6,13 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 #include <vector>
 
 #include "core/body15.hpp"
 #include "core/messages.hpp"
+#include "motion/canonical_body.hpp"
 #include "posedb/database.hpp"
 
 namespace mocap::recon {
@@ -50,12 +52,20 @@ class Matcher {
   // Returns false when the pose cannot be normalised.
   bool match(std::span<const float, kBodyJoints * 3> body_xyc, std::vector<Candidate>& out);
 
+  // The person's own proportions, when known (fitted, or given in an evaluation): the k
+  // candidates are then re-scored on them (each candidate's 3D pose retargeted to the person,
+  // projected with its view, normalised and compared with the query again) and re-sorted.
+  // std::nullopt (the default) compares on the database's body as stored.
+  void set_person(std::optional<motion::BodyProportions> person) { person_ = std::move(person); }
+  const std::optional<motion::BodyProportions>& person() const { return person_; }
+
   const MatchOptions& options() const { return options_; }
   const posedb::Database& database() const { return db_; }
 
  private:
   const posedb::Database& db_;
   MatchOptions options_;
+  std::optional<motion::BodyProportions> person_;
   struct Search;
   std::unique_ptr<Search> search_;
 };

@@ -19,6 +19,7 @@
 #include "eval/virtual_protocol.hpp"
 #include "eval_configs.hpp"
 #include "eval_report.hpp"
+#include "motion/canonical_body.hpp"
 #include "posedb/builder.hpp"
 #include "posedb/database.hpp"
 #include "progress_bar.hpp"
@@ -55,6 +56,10 @@ std::vector<eval::Scores> run_jobs(const std::vector<Config>& configs,
       matchers.push_back(std::make_unique<recon::Matcher>(*c.db, c.match));
     for (std::size_t i; (i = next++) < jobs.size();) {
       const Job& j = jobs[i];
+      matchers[j.config]->set_person(
+          configs[j.config].person_bones
+              ? std::optional(motion::measure_proportions(truth[j.sequence].world, false))
+              : std::nullopt);
       const std::uint64_t seed = 1000003ull * j.sequence + 1009ull * j.camera +
                                  j.condition;  // same input for every config
       const auto rendered =
@@ -86,6 +91,59 @@ std::vector<eval::Scores> run_jobs(const std::vector<Config>& configs,
   return summed;
 }
 
+std::vector<std::string> split_list(const std::string& text) {
+  std::vector<std::string> out;
+  std::stringstream in(text);
+  for (std::string item; std::getline(in, item, ',');)
+    if (!item.empty()) out.push_back(item);
+  return out;
+}
+
+// The configurations of every database (named "[label] ..." when there are several), the
+// paper's once, filtered by --configs, each doubled with --person-bones.
+std::vector<Config> select_configs(const std::vector<posedb::Database>& databases,
+                                   const std::vector<std::string>& labels,
+                                   const posedb::Database& paper, const Args& args) {
+  const auto prefixes = split_list(args.has("configs") ? args.get("configs") : "");
+  auto wanted = [&](const std::string& name) {
+    return prefixes.empty() || std::any_of(prefixes.begin(), prefixes.end(), [&](const auto& p) {
+             return name.compare(0, p.size(), p) == 0;
+           });
+  };
+  std::vector<Config> out;
+  for (std::size_t d = 0; d < databases.size(); ++d) {
+    for (Config c : make_configs(databases[d], paper, databases[d].build_info().fps)) {
+      const bool is_paper = c.db == &paper;
+      if (!wanted(c.name) || (is_paper && d > 0)) continue;
+      if (databases.size() > 1 && !is_paper) c.name = "[" + labels[d] + "] " + c.name;
+      out.push_back(c);
+      if (args.has("person-bones") && !is_paper) {
+        c.name += " + person bones";
+        c.description += "; candidates re-scored on the person's proportions (given)";
+        c.person_bones = true;
+        out.push_back(c);
+      }
+    }
+  }
+  if (out.empty()) throw InputError("--configs", "no configuration matches");
+  return out;
+}
+
+json databases_json(const std::vector<posedb::Database>& databases,
+                    const std::vector<std::string>& labels) {
+  json out = json::array();
+  for (std::size_t d = 0; d < databases.size(); ++d) {
+    std::map<std::string, std::uint64_t> frames;
+    for (const auto& c : databases[d].clips()) frames[c.family] += c.frame_count;
+    out.push_back({{"label", labels[d]},
+                   {"file", databases[d].path()},
+                   {"frames", databases[d].frames().size()},
+                   {"frames_per_family", frames},
+                   {"build", json::parse(databases[d].options_json())}});
+  }
+  return out;
+}
+
 int virtual_protocol(int argc, char** argv) {
   Args args(
       "mocap eval virtual --db DB [options]",
@@ -94,8 +152,17 @@ int virtual_protocol(int argc, char** argv) {
       "pitches, 2D noise and joint drop-out; MPJPE, PA-MPJPE, acceleration error and jitter per "
       "configuration,\n"
       "noise level and camera family. Prints Markdown tables and writes every number as JSON.");
-  args.option("db", "FILE",
-              "database built from the train split (mocap db build ... --split train)")
+  args.option("db", "[LABEL=]FILE",
+              "database built from the train split (mocap db build ... --split train); repeat "
+              "to compare\nseveral side by side in one run (configurations named [LABEL] ..., "
+              "LABEL = file stem\nwhen not given)",
+              std::nullopt, true)
+      .option("configs", "LIST",
+              "only the configurations whose names start with one of these comma-separated "
+              "prefixes\n(e.g. \"per-frame NN,full:\"); all when absent")
+      .flag("person-bones",
+            "add each configuration once more with the candidates re-scored on the person's "
+            "own\nproportions, given from the truth clip (\"... + person bones\")")
       .option("paper-db", "FILE",
               "the paper's yaw-only 1.5 m database (built from the train split when absent)")
       .option("mocap", "DIR", "cmu31 folder with splits.txt", "../shared/data/mocap/cmu31")
@@ -107,7 +174,18 @@ int virtual_protocol(int argc, char** argv) {
   if (!args.parse(argc, argv, code)) return code;
   if (!args.has("db")) throw InputError("--db", "required: a database built from the train split");
   const auto started = std::chrono::steady_clock::now();
-  const posedb::Database full = posedb::Database::open(args.get("db"));
+  std::vector<std::string> labels;
+  std::vector<posedb::Database> databases;
+  for (const std::string& given : args.all("db")) {
+    const auto eq = given.find('=');
+    const std::string file = eq == std::string::npos ? given : given.substr(eq + 1);
+    labels.push_back(eq == std::string::npos ? fs::path(file).stem().string()
+                                             : given.substr(0, eq));
+    databases.push_back(posedb::Database::open(file));
+    if (databases.back().build_info().fps != databases.front().build_info().fps)
+      throw InputError(file, "built at another frame rate than the first --db");
+  }
+  const posedb::Database& full = databases.front();
   const std::string mocap = args.get("mocap");
   const posedb::Database paper =
       open_paper_database(args.get("paper-db"), mocap, "mocap eval virtual");
@@ -117,7 +195,7 @@ int virtual_protocol(int argc, char** argv) {
     truth.resize(n);
   const auto cameras = eval::default_cameras(args.has("quick"));
   const auto conditions = eval::default_conditions(args.has("quick"));
-  const auto configs = make_configs(full, paper, full.build_info().fps);
+  const auto configs = select_configs(databases, labels, paper, args);
   std::vector<std::unique_ptr<recon::FrameBones>> bones;
   for (const auto& c : configs) bones.push_back(std::make_unique<recon::FrameBones>(*c.db));
 
@@ -139,6 +217,7 @@ int virtual_protocol(int argc, char** argv) {
               {"git_commit", git_commit()},
               {"machine", machine_description()},
               {"database", json::parse(full.options_json())},
+              {"databases", databases_json(databases, labels)},
               {"paper_database", json::parse(paper.options_json())},
               {"clips", truth.size()},
               {"frames", frames}};
@@ -181,6 +260,16 @@ int virtual_protocol(int argc, char** argv) {
   }
   std::cout << "\nConfigurations:\n";
   for (const auto& c : configs) std::cout << "- " << c.name << ": " << c.description << "\n";
+  std::cout << "\nDatabases:\n";
+  for (const auto& d : out["databases"]) {
+    std::cout << "- " << d["label"].get<std::string>() << ": " << d["file"].get<std::string>()
+              << ", body " << d["build"].value("body", "source") << ", " << d["frames"]
+              << " frames (";
+    const char* sep = "";
+    for (const auto& [family, n] : d["frames_per_family"].items())
+      std::cout << sep << family << " " << n, sep = ", ";
+    std::cout << ")\n";
+  }
   out["seconds"] =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   std::ofstream(args.get("json")) << out.dump(2) << "\n";

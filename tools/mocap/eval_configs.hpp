@@ -24,6 +24,9 @@ struct Config {
   recon::SequenceOptions sequence;
   // Turn every pose onto the ray through its root pixel, with the protocol's true intrinsics.
   bool align_to_ray = false;
+  // Re-score the matcher's candidates on the person's own proportions (Matcher::set_person); in
+  // the virtual protocol they are given, measured from the truth clip.
+  bool person_bones = false;
 };
 
 // The paper's configuration on `paper` (its yaw-only database), then per-frame nearest
