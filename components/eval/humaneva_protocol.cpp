@@ -128,12 +128,19 @@ std::vector<HumanEvaSequence> humaneva_validation_sequences(const he::Dataset& d
 
 Scores evaluate_sequence(recon::Matcher& matcher, const recon::FrameBones& bones,
                          const HumanEvaSequence& sequence, const Condition& condition,
-                         const recon::SequenceOptions& options, std::uint64_t seed) {
+                         const recon::SequenceOptions& options, std::uint64_t seed,
+                         const recon::LayoutOffsets* map_back, Scores* mapped) {
   std::vector<recon::BodyXyc> input = sequence.input;
   InputNoise noise(seed);
   for (recon::BodyXyc& frame : input) noise.apply(condition, frame);
-  const auto poses = recon::reconstruct_sequence(matcher, bones, input, options);
-  return score(poses, sequence.truth_camera);
+  auto poses = recon::reconstruct_sequence(matcher, bones, input, options);
+  const Scores canonical = score(poses, sequence.truth_camera);
+  if (map_back && mapped) {
+    for (recon::Pose3D& pose : poses)
+      if (pose.valid) recon::apply_layout_offsets_3d(*map_back, pose.joints, -1.0f);
+    *mapped = score(poses, sequence.truth_camera);
+  }
+  return canonical;
 }
 
 void HumanEvaTable::add(const HumanEvaSequence& sequence, const Scores& scores) {

@@ -73,9 +73,13 @@ std::vector<HumanEvaSequence> humaneva_validation_sequences(const io::humaneva::
                                                             double fps);
 
 // Adds the condition's noise to the input, reconstructs it and scores it against the truth.
+// With `map_back` and `mapped`, the reconstruction is also scored after moving its canonical
+// joints to where the layout puts them (recon::apply_layout_offsets_3d, direction -1): the
+// truth is in HumanEva-15's own definition (thorax, pelvis, headDistal), not the canonical one.
 Scores evaluate_sequence(recon::Matcher& matcher, const recon::FrameBones& bones,
                          const HumanEvaSequence& sequence, const Condition& condition,
-                         const recon::SequenceOptions& options, std::uint64_t seed);
+                         const recon::SequenceOptions& options, std::uint64_t seed,
+                         const recon::LayoutOffsets* map_back = nullptr, Scores* mapped = nullptr);
 
 // Scores per (subject, action) cell, as the published tables.
 class HumanEvaTable {

@@ -107,8 +107,15 @@ void smooth_sequence(std::vector<Pose3D>& poses, const SequenceOptions& options)
 }
 
 std::vector<Pose3D> reconstruct_sequence(Matcher& matcher, const FrameBones& bones,
-                                         std::span<const BodyXyc> frames,
+                                         std::span<const BodyXyc> input,
                                          const SequenceOptions& options) {
+  std::vector<BodyXyc> corrected;
+  if (options.layout_offsets) {
+    corrected.assign(input.begin(), input.end());
+    for (BodyXyc& frame : corrected) apply_layout_offsets(*options.layout_offsets, frame);
+  }
+  const std::span<const BodyXyc> frames =
+      options.layout_offsets ? std::span<const BodyXyc>(corrected) : input;
   std::vector<std::vector<Candidate>> candidates(frames.size());
   for (std::size_t t = 0; t < frames.size(); ++t) matcher.match(frames[t], candidates[t]);
 

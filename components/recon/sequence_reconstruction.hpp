@@ -12,6 +12,7 @@
 #include <glm/gtc/quaternion.hpp>
 #include <glm/vec3.hpp>
 
+#include "recon/layout_offsets.hpp"
 #include "recon/matcher.hpp"
 #include "recon/one_euro_filter.hpp"
 #include "recon/ray_alignment.hpp"
@@ -38,6 +39,9 @@ struct SequenceOptions {
   Pinhole camera;
   // Search yaw and elevation around the matched view for the best fit (view_refinement.hpp).
   bool refine_view = false;
+  // The input layout's keypoints moved onto the canonical joints before matching (the scaler's
+  // step, layout_offsets.hpp); none: the keypoints are matched as they are.
+  std::optional<LayoutOffsets> layout_offsets;
 };
 
 using BodyXyc = std::array<float, kBodyJoints * 3>;  // 15 joints (x, y, confidence), image pixels

@@ -12,5 +12,6 @@ int eval_command(int argc, char** argv);
 int humaneva_eval_command(int argc, char** argv);
 int reconstruct_command(int argc, char** argv);
 int camera_command(int argc, char** argv);
+int calibrate_command(int argc, char** argv);
 
 }  // namespace mocap::cli

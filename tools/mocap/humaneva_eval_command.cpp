@@ -10,6 +10,8 @@
 #include <iostream>
 #include <map>
 #include <memory>
+#include <optional>
+#include <sstream>
 
 #include <nlohmann/json.hpp>
 
@@ -21,6 +23,7 @@
 #include "eval_report.hpp"
 #include "posedb/parallel_chunks.hpp"
 #include "progress_bar.hpp"
+#include "recon/layout_offsets.hpp"
 
 namespace mocap::cli {
 namespace {
@@ -41,7 +44,7 @@ struct DatabaseFamily {
   std::string name;
   std::string description;
   posedb::Database full;
-  posedb::Database paper;
+  std::optional<posedb::Database> paper;  // absent when no selected configuration needs it
 };
 
 // Build options that give the view set, scaling and rate of an existing database.
@@ -89,7 +92,7 @@ posedb::Database humaneva_full_database(const std::vector<posedb::BodySequence>&
 
 // HumanEva's own databases: the full view set and the paper's.
 DatabaseFamily humaneva_family(const he::Dataset& data, const posedb::Database& cmu,
-                               const std::string& given, int threads) {
+                               const std::string& given, int threads, bool with_paper) {
   const auto motion = eval::humaneva_body_sequences(data, he::Split::train, training_actions());
   std::cerr << "building the HumanEva Train databases from " << motion.size() << " chunks\n";
   posedb::BuildOptions paper_options =
@@ -97,50 +100,94 @@ DatabaseFamily humaneva_family(const he::Dataset& data, const posedb::Database& 
                           ", paper database: yaw-only views at 1.5 m)");
   paper_options.fps = cmu.build_info().fps;
   paper_options.threads = threads;
-  return {"HumanEva Train", std::string("built from ") + kTrainedOn,
-          humaneva_full_database(motion, cmu, given, threads),
-          build_from_humaneva(motion, paper_options, "humaneva-paper")};
+  DatabaseFamily family{"HumanEva Train", std::string("built from ") + kTrainedOn,
+                        humaneva_full_database(motion, cmu, given, threads), std::nullopt};
+  if (with_paper) family.paper = build_from_humaneva(motion, paper_options, "humaneva-paper");
+  return family;
 }
 
 struct Job {
   std::size_t family, config, condition, sequence;
 };
 
-// Every (family, configuration, condition) for every sequence, on `threads` threads. A matcher
-// per job: it is cheap to make and keeps scratch space, so it is never shared between threads.
-std::vector<eval::Scores> run_jobs(const std::vector<std::vector<Config>>& configs,
-                                   const std::vector<eval::Condition>& conditions,
-                                   const std::vector<eval::HumanEvaSequence>& sequences,
-                                   int threads) {
+// A configuration as one run compares it: with or without the layout offsets of the input
+// (HumanEva-15 -> canonical joints before matching).
+struct Variant {
+  Config config;
+  const recon::LayoutOffsets* offsets = nullptr;
+};
+
+// One row of the tables: a name and its scores per (condition, sequence), in job order.
+struct Row {
+  std::string name, description;
+  std::vector<eval::Scores> scores;
+};
+
+// Every (family, variant, condition) for every sequence, on `threads` threads. A matcher per
+// job: it is cheap to make and keeps scratch space, so it is never shared between threads. A
+// variant with offsets gives two rows: its canonical output, and that output mapped back into
+// HumanEva-15's own joint definition.
+std::vector<std::vector<Row>> run_jobs(const std::vector<std::vector<Variant>>& variants,
+                                       const std::vector<eval::Condition>& conditions,
+                                       const std::vector<eval::HumanEvaSequence>& sequences,
+                                       int threads) {
   std::vector<Job> jobs;
-  for (std::size_t f = 0; f < configs.size(); ++f)
-    for (std::size_t c = 0; c < configs[f].size(); ++c)
+  for (std::size_t f = 0; f < variants.size(); ++f)
+    for (std::size_t c = 0; c < variants[f].size(); ++c)
       for (std::size_t n = 0; n < conditions.size(); ++n)
         for (std::size_t s = 0; s < sequences.size(); ++s) jobs.push_back({f, c, n, s});
   std::map<const posedb::Database*, std::unique_ptr<recon::FrameBones>> bones;
-  for (const auto& family : configs)
-    for (const Config& config : family)
-      if (!bones.contains(config.db))
-        bones[config.db] = std::make_unique<recon::FrameBones>(*config.db);
-  std::vector<eval::Scores> results(jobs.size());
+  for (const auto& family : variants)
+    for (const Variant& v : family)
+      if (!bones.contains(v.config.db))
+        bones[v.config.db] = std::make_unique<recon::FrameBones>(*v.config.db);
+  std::vector<eval::Scores> results(jobs.size()), mapped(jobs.size());
   ProgressBar bar;
   posedb::for_each_chunk(
       jobs.size(), threads,
       [&](std::size_t i) {
         const Job& job = jobs[i];
-        const Config& config = configs[job.family][job.config];
+        const Variant& variant = variants[job.family][job.config];
+        const Config& config = variant.config;
         recon::Matcher matcher(*config.db, config.match);
         const std::uint64_t seed = 1000003ull * job.sequence + job.condition;  // same for all
         recon::SequenceOptions options = config.sequence;
         if (config.align_to_ray) options.camera = sequences[job.sequence].intrinsics;
+        if (variant.offsets) options.layout_offsets = *variant.offsets;
         results[i] = eval::evaluate_sequence(matcher, *bones.at(config.db), sequences[job.sequence],
-                                             conditions[job.condition], options, seed);
+                                             conditions[job.condition], options, seed,
+                                             variant.offsets, &mapped[i]);
       },
       [&](std::size_t done) {
         bar.update("evaluate", static_cast<double>(done) / static_cast<double>(jobs.size()));
       });
   bar.finish();
-  return results;
+  std::vector<std::vector<Row>> rows(variants.size());
+  std::size_t i = 0;
+  for (std::size_t f = 0; f < variants.size(); ++f) {
+    for (const Variant& v : variants[f]) {
+      const std::size_t n = conditions.size() * sequences.size();
+      Row row{v.config.name, v.config.description, {}};
+      row.scores.assign(results.begin() + i, results.begin() + i + n);
+      if (v.offsets) {
+        row.name += " + offsets";
+        row.description +=
+            "; input moved onto the canonical joints (" + v.offsets->source + "), output canonical";
+        Row back{v.config.name + " + offsets, mapped back",
+                 v.config.description + "; input moved onto the canonical joints (" +
+                     v.offsets->source +
+                     "), output mapped back into HumanEva-15's thorax/pelvis/headDistal",
+                 {}};
+        back.scores.assign(mapped.begin() + i, mapped.begin() + i + n);
+        rows[f].push_back(std::move(row));
+        rows[f].push_back(std::move(back));
+      } else {
+        rows[f].push_back(std::move(row));
+      }
+      i += n;
+    }
+  }
+  return rows;
 }
 
 std::string cell_name(std::string_view action, std::string_view subject) {
@@ -193,13 +240,10 @@ constexpr const char* kJointNote =
     "head = headDistal)";
 
 // Tables per family and the JSON of every number.
-json report(const std::vector<DatabaseFamily>& families,
-            const std::vector<std::vector<Config>>& configs,
+json report(const std::vector<DatabaseFamily>& families, const std::vector<std::vector<Row>>& rows,
             const std::vector<eval::Condition>& conditions,
-            const std::vector<eval::HumanEvaSequence>& sequences,
-            const std::vector<eval::Scores>& results) {
+            const std::vector<eval::HumanEvaSequence>& sequences) {
   json out = json::object();
-  std::size_t i = 0;  // results are in job order: family, config, condition, sequence
   for (std::size_t f = 0; f < families.size(); ++f) {
     print_cells_header(families[f].name);
     struct Total {
@@ -208,29 +252,30 @@ json report(const std::vector<DatabaseFamily>& families,
     };
     std::vector<Total> totals;
     json per_config = json::object();
-    for (const Config& config : configs[f]) {
+    for (const Row& row : rows[f]) {
+      std::size_t i = 0;  // scores are in job order: condition, sequence
       json per_condition = json::object();
       for (const eval::Condition& condition : conditions) {
         eval::HumanEvaTable table;
-        for (const auto& sequence : sequences) table.add(sequence, results[i++]);
-        print_cells_row(config.name, condition.label(), table);
+        for (const auto& sequence : sequences) table.add(sequence, row.scores[i++]);
+        print_cells_row(row.name, condition.label(), table);
         per_condition[condition.label()] = table_json(table);
-        totals.push_back({config.name, condition.label(), table.all()});
+        totals.push_back({row.name, condition.label(), table.all()});
       }
-      per_config[config.name] = {{"description", config.description},
-                                 {"per_condition", per_condition}};
+      per_config[row.name] = {{"description", row.description}, {"per_condition", per_condition}};
     }
     std::cout
         << "\n## HumanEva-I Validate, " << families[f].name
         << " database: all frames\n\n| configuration | condition | MPJPE mm | PA-MPJPE mm "
            "| accel err mm/f² | jitter mm/f² | coverage |\n|---|---|---:|---:|---:|---:|---:|\n";
     for (const Total& t : totals) print_row(t.config, t.condition, t.scores);
-    out[families[f].name] = {{"description", families[f].description},
-                             {"database_frames", families[f].full.frames().size()},
-                             {"database_projections", families[f].full.projections().rows},
-                             {"database", json::parse(families[f].full.options_json())},
-                             {"paper_database", json::parse(families[f].paper.options_json())},
-                             {"configurations", per_config}};
+    json entry = {{"description", families[f].description},
+                  {"database_frames", families[f].full.frames().size()},
+                  {"database_projections", families[f].full.projections().rows},
+                  {"database", json::parse(families[f].full.options_json())},
+                  {"configurations", per_config}};
+    if (families[f].paper) entry["paper_database"] = json::parse(families[f].paper->options_json());
+    out[families[f].name] = entry;
   }
   return out;
 }
@@ -262,6 +307,16 @@ int humaneva_eval_command(int argc, char** argv) {
               "../shared/data/eval/humaneva_i_videopose3d")
       .option("json", "FILE", "where to write all numbers", "eval_humaneva.json")
       .option("threads", "N", "worker threads", "2")
+      .option("configs", "NAMES",
+              "comma-separated configurations to run (e.g. 'per-frame NN,full: path + SG + ray + "
+              "view'; all when absent)")
+      .option("layout-offsets", "off|auto|FILE|compare",
+              "move the HumanEva-15 input onto the canonical joints before matching with the CMU "
+              "database (auto: calibration/layouts/humaneva15.yaml); compare: every "
+              "configuration with and without. Rows with offsets are scored twice: the canonical "
+              "output, and that output mapped back into HumanEva's own joints",
+              "off")
+      .flag("no-humaneva-db", "skip the databases built from HumanEva Train")
       .flag("quick", "2 noise levels instead of 5");
   int code = 0;
   if (!args.parse(argc, argv, code)) return code;
@@ -272,25 +327,62 @@ int humaneva_eval_command(int argc, char** argv) {
   const he::Dataset data = he::load_dataset(folder);
   const auto cameras = he::load_cameras(std::filesystem::path(folder) / he::kCamerasFile);
 
+  std::vector<std::string> wanted;
+  if (args.has("configs")) {
+    std::stringstream list(args.get("configs"));
+    for (std::string name; std::getline(list, name, ',');)
+      if (!name.empty()) wanted.push_back(name);
+  }
+  const auto selected = [&](const std::string& name) {
+    return wanted.empty() || std::find(wanted.begin(), wanted.end(), name) != wanted.end();
+  };
+  const bool with_paper = selected("paper");
+  const std::string offsets_setting = args.get("layout-offsets");
+  const bool compare = offsets_setting == "compare";
+  const std::optional<recon::LayoutOffsets> offsets =
+      offsets_setting == "off"
+          ? std::nullopt
+          : recon::resolve_layout_offsets(compare ? "auto" : offsets_setting, LayoutId::humaneva15);
+  if (offsets_setting != "off" && !offsets)
+    throw InputError("--layout-offsets", "no " +
+                                             recon::layout_offsets_file_name(LayoutId::humaneva15) +
+                                             " in calibration/layouts (mocap calibrate layout)");
+
   std::vector<DatabaseFamily> families;
   posedb::Database cmu = posedb::Database::open(args.get("db"));
-  posedb::Database cmu_paper =
-      open_paper_database(args.get("paper-db"), args.get("mocap"), "mocap eval humaneva");
-  DatabaseFamily own = humaneva_family(data, cmu, args.get("humaneva-db"), threads);
+  std::optional<posedb::Database> cmu_paper;
+  if (with_paper)
+    cmu_paper = open_paper_database(args.get("paper-db"), args.get("mocap"), "mocap eval humaneva");
+  std::optional<DatabaseFamily> own;
+  if (!args.has("no-humaneva-db"))
+    own = humaneva_family(data, cmu, args.get("humaneva-db"), threads, with_paper);
   families.push_back(
       {"CMU train", "the --db database (cross-dataset)", std::move(cmu), std::move(cmu_paper)});
-  families.push_back(std::move(own));
+  if (own) families.push_back(std::move(*own));
   const double fps = families.front().full.build_info().fps;
 
-  std::vector<std::vector<Config>> configs;
-  for (const auto& family : families)
-    configs.push_back(make_configs(family.full, family.paper, fps));
+  // Offsets apply to the CMU database only: the HumanEva databases are made of HumanEva's own
+  // joints (thorax, pelvis, headDistal), which its 2D input already matches.
+  std::vector<std::vector<Variant>> variants;
+  for (std::size_t f = 0; f < families.size(); ++f) {
+    const auto& family = families[f];
+    std::vector<Variant> list;
+    for (const Config& c :
+         make_configs(family.full, family.paper ? *family.paper : family.full, fps)) {
+      if (!selected(c.name)) continue;
+      const bool cmu_family = f == 0;
+      if (!offsets || compare || !cmu_family) list.push_back({c, nullptr});
+      if (offsets && cmu_family) list.push_back({c, &*offsets});
+    }
+    if (list.empty()) throw InputError("--configs", "no configuration of that name");
+    variants.push_back(std::move(list));
+  }
   const auto conditions = eval::default_conditions(args.has("quick"));
   const auto sequences = eval::humaneva_validation_sequences(data, cameras, fps);
-  std::cerr << "evaluating " << configs.front().size() << " configurations x " << families.size()
+  std::cerr << "evaluating " << variants.front().size() << " configurations x " << families.size()
             << " databases on " << sequences.size() << " sequences (chunk x camera) x "
             << conditions.size() << " conditions\n";
-  const auto results = run_jobs(configs, conditions, sequences, threads);
+  const auto rows = run_jobs(variants, conditions, sequences, threads);
 
   json out = {{"protocol", "humaneva"},
               {"command", command_line(argc, argv)},
@@ -302,12 +394,13 @@ int humaneva_eval_command(int argc, char** argv) {
               {"joints", kJointNote},
               {"joint_correspondence", eval::humaneva_joint_correspondence()},
               {"validation", sequences_json(sequences)}};
-  out["results"] = report(families, configs, conditions, sequences, results);
+  if (offsets) out["layout_offsets"] = offsets->source;
+  out["results"] = report(families, rows, conditions, sequences);
   std::cout << "\nJoints: " << kJointNote << ":\n";
   for (const auto& line : eval::humaneva_joint_correspondence()) std::cout << "- " << line << "\n";
   std::cout << "\nRate: " << kRateNote << ".\n\nConfigurations:\n";
-  for (const auto& c : configs.front())
-    std::cout << "- " << c.name << ": " << c.description << "\n";
+  for (const auto& row : rows.front())
+    std::cout << "- " << row.name << ": " << row.description << "\n";
   out["seconds"] =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   std::ofstream(args.get("json")) << out.dump(2) << "\n";

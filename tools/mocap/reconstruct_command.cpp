@@ -138,6 +138,7 @@ void configure(graph::GraphSpec& spec, const Args& args, const fs::path& out) {
     set_param(spec, type, "db", args.get("db"));
   }
   set_param(spec, "recon.temporal_selector", "mode", args.get("mode"));
+  set_param(spec, "recon.scaler", "layout_offsets", args.get("layout-offsets"));
   if (args.has("image-size")) {
     const std::string size = args.get("image-size");
     const auto x = size.find('x');
@@ -218,6 +219,10 @@ int reconstruct_command(int argc, char** argv) {
       .option("hfov", "DEG", "horizontal field of view assumed with --image-size", "60")
       .option("mode", "NAME",
               "temporal selection: path (Viterbi, lag 8), greedy (the paper) or nearest", "path")
+      .option("layout-offsets", "auto|off|FILE",
+              "move the input layout's keypoints onto the canonical joint centres before "
+              "matching (auto: calibration/layouts/<layout>.yaml; docs/keypoint-layouts.md)",
+              "off")
       .option("graph", "FILE",
               "graph to run (default: graphs/monocular_json.yaml for OpenPose JSON, "
               "graphs/monocular_video.yaml otherwise)")

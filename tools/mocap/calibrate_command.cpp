@@ -1,0 +1,210 @@
+// `mocap calibrate layout`: measures where a keypoint layout puts its joints relative to the
+// canonical body's joint centres (eval/layout_calibration.hpp) and writes the coefficients of the
+// correction (recon/layout_offsets.hpp) as calibration/layouts/<layout>.yaml.
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <sstream>
+
+#include "cli_args.hpp"
+#include "commands.hpp"
+#include "core/input_error.hpp"
+#include "eval/layout_calibration.hpp"
+
+namespace mocap::cli {
+namespace {
+
+namespace fs = std::filesystem;
+namespace he = io::humaneva;
+
+struct Trial {
+  std::string name;
+  std::vector<eval::CalibrationFrame> frames;
+};
+
+// Every <trial>/pose-3d/*_LSTM.trc under the Pose2Sim folder, in name order.
+std::vector<Trial> pose2sim_trials(const fs::path& folder, LayoutId layout) {
+  if (!fs::is_directory(folder)) throw InputError(folder.string(), "not a folder");
+  std::vector<fs::path> files;
+  for (const auto& trial : fs::directory_iterator(folder)) {
+    const fs::path dir = trial.path() / "pose-3d";
+    if (!fs::is_directory(dir)) continue;
+    for (const auto& f : fs::directory_iterator(dir))
+      if (f.path().filename().string().ends_with("_LSTM.trc")) files.push_back(f.path());
+  }
+  std::sort(files.begin(), files.end());
+  if (files.empty())
+    throw InputError(folder.string(), "no <trial>/pose-3d/*_LSTM.trc files (Pose2Sim demo)");
+  std::vector<Trial> out;
+  for (const fs::path& f : files)
+    out.push_back({f.filename().string(), eval::pose2sim_frames(io::read_trc(f), layout)});
+  return out;
+}
+
+std::string fixed(double v, int digits) {
+  std::ostringstream s;
+  s << std::fixed << std::setprecision(digits) << v;
+  return s.str();
+}
+
+// The fit as a Markdown table (also written, commented, into the file).
+std::string fit_table(const eval::LayoutFit& fit) {
+  std::ostringstream t;
+  t << "| joint | basis | along | lateral | forward (3D only) | along mm | lateral mm | forward mm "
+       "| offset up/left/fwd mm | frames | before mm | after (2D part) mm | after (3D) mm "
+       "|\n|---|---|---:|---:|---:|---:|---:|---:|---|---:|---:|---:|---:|\n";
+  for (int j = 0; j < kBodyJoints; ++j) {
+    const auto& o = fit.offsets.joints[j];
+    const auto& f = fit.joints[j];
+    t << "| " << kJointNames[j] << " | " << recon::basis_name(o.basis) << " | " << fixed(o.along, 4)
+      << " | " << fixed(o.lateral, 4) << " | " << fixed(o.forward, 4) << " | "
+      << fixed(f.along_mm, 1) << " | " << fixed(f.lateral_mm, 1) << " | " << fixed(f.forward_mm, 1)
+      << " | " << fixed(f.mean_offset_mm.x, 0) << " / " << fixed(f.mean_offset_mm.y, 0) << " / "
+      << fixed(f.mean_offset_mm.z, 0) << " | " << f.frames << " | " << fixed(f.before_mm, 1)
+      << " | " << fixed(f.after_mm, 1) << " | " << fixed(f.after_3d_mm, 1) << " |\n";
+  }
+  return t.str();
+}
+
+std::string check_table(const std::string& title,
+                        const std::array<eval::JointFit, kBodyJoints>& rows) {
+  std::ostringstream t;
+  t << title << "\n\n| joint | samples | before mm | after mm |\n|---|---:|---:|---:|\n";
+  double before = 0, after = 0, n = 0;
+  for (int j = 0; j < kBodyJoints; ++j) {
+    if (rows[j].frames == 0) continue;
+    t << "| " << kJointNames[j] << " | " << rows[j].frames << " | " << fixed(rows[j].before_mm, 1)
+      << " | " << fixed(rows[j].after_mm, 1) << " |\n";
+    before += rows[j].before_mm;
+    after += rows[j].after_mm;
+    ++n;
+  }
+  if (n > 0)
+    t << "| mean of joints | | " << fixed(before / n, 1) << " | " << fixed(after / n, 1) << " |\n";
+  return t.str();
+}
+
+std::string command_line(int argc, char** argv) {
+  std::string line = "mocap calibrate layout";
+  for (int i = 0; i < argc; ++i) line.append(" ").append(argv[i]);
+  return line;
+}
+
+constexpr const char* kModel =
+    "offset = along * T + lateral * (left - right) for the shoulders/hips bases, along * (joint - "
+    "parent) for bone, T = mid-shoulders - mid-hips, all from the layout's own keypoints; fitted "
+    "by least squares in 3D, applied in 2D (docs/keypoint-layouts.md)";
+
+int layout_command(int argc, char** argv) {
+  Args args("mocap calibrate layout (--pose2sim DIR | --humaneva DIR) --layout NAME [--out FILE]",
+            "Fits where a keypoint layout puts its joints relative to the canonical joint "
+            "centres and writes\nthe coefficients (calibration/layouts/<layout>.yaml). Pose2Sim: "
+            "BODY_25B keypoints triangulated,\nreference from the LSTM anatomical markers "
+            "(COCO-17, BODY_25, COCO-18 from the BODY_25B keypoints\nthey share). HumanEva: "
+            "HumanEva-15 from its Train 3D. Prints the fit and checks as Markdown.");
+  args.option("pose2sim", "DIR", "the Pose2Sim demo folder (trials with pose-3d/*_LSTM.trc)")
+      .option("humaneva", "DIR", "HumanEva-I in the VideoPose3D format")
+      .option("layout", "NAME", "BODY_25B, COCO-17, BODY_25, COCO-18 (Pose2Sim) or HumanEva-15",
+              "BODY_25B")
+      .option("out", "FILE", "where to write the offsets (nothing written when absent)");
+  int code = 0;
+  if (!args.parse(argc, argv, code)) return code;
+  const KeypointLayout* lay = find_layout(args.get("layout"));
+  if (!lay) throw InputError("--layout", "unknown layout '" + args.get("layout") + "'");
+  if (args.has("pose2sim") == args.has("humaneva"))
+    throw InputError("mocap calibrate layout", "give exactly one of --pose2sim and --humaneva");
+
+  std::vector<Trial> trials;
+  std::string source;
+  if (args.has("pose2sim")) {
+    trials = pose2sim_trials(args.get("pose2sim"), lay->id);
+    source = "Pose2Sim demo " + args.get("pose2sim") + " (";
+    for (const auto& t : trials)
+      source += t.name + ": " + std::to_string(t.frames.size()) + " frames; ";
+    source +=
+        "keypoints = the triangulated, filtered BODY_25B markers; reference = the LSTM "
+        "anatomical markers)";
+  } else {
+    if (lay->id != LayoutId::humaneva15)
+      throw InputError("--layout", "HumanEva data gives HumanEva-15 only");
+    he::LoadOptions options;
+    options.load_2d = false;
+    const he::Dataset data = he::load_dataset(args.get("humaneva"), options);
+    trials.push_back({"Train", eval::humaneva_frames(data, he::Split::train)});
+    trials.push_back({"Validate", eval::humaneva_frames(data, he::Split::validate)});
+    source = "HumanEva-I " + args.get("humaneva") + " Train split 3D (" +
+             std::to_string(trials[0].frames.size()) +
+             " frames); reference: shoulders and hips are joint centres in both, neck/head/root "
+             "from their midpoints";
+  }
+  // HumanEva: fit on Train only, check on Validate. Pose2Sim: fit on all trials.
+  std::vector<eval::CalibrationFrame> fit_frames;
+  for (const auto& t : trials) {
+    if (lay->id == LayoutId::humaneva15 && t.name != "Train") continue;
+    fit_frames.insert(fit_frames.end(), t.frames.begin(), t.frames.end());
+  }
+  const eval::LayoutFit fit =
+      eval::fit_layout_offsets(lay->id, fit_frames, eval::default_bases(lay->id));
+  std::ostringstream report;
+  report << "## " << lay->name << ": fitted offsets (3D, " << fit_frames.size()
+         << " frames; offset = reference - keypoint in the body frame before correction)\n\n"
+         << fit_table(fit);
+  if (!fit.notes.empty()) report << "\n" << fit.notes;
+  std::cout << report.str();
+
+  if (lay->id == LayoutId::humaneva15) {
+    std::cout << "\n"
+              << check_table("## HumanEva-15: held-out check on Validate 3D (fitted on Train)",
+                             eval::evaluate_offsets_3d(fit.offsets, trials[1].frames));
+  } else {
+    // Cross-trial: fit on one trial, check on the other.
+    for (std::size_t a = 0; a < trials.size() && trials.size() > 1; ++a) {
+      std::vector<eval::CalibrationFrame> rest;
+      for (std::size_t b = 0; b < trials.size(); ++b)
+        if (b != a) rest.insert(rest.end(), trials[b].frames.begin(), trials[b].frames.end());
+      const auto other = eval::fit_layout_offsets(lay->id, rest, eval::default_bases(lay->id));
+      std::cout << "\n"
+                << check_table("## " + std::string(lay->name) + ": 3D check on " + trials[a].name +
+                                   ", fitted on the other trial(s)",
+                               eval::evaluate_offsets_3d(other.offsets, trials[a].frames));
+    }
+    const fs::path toml = fs::path(args.get("pose2sim")) / "calibration" / "Calib_qualisys.toml";
+    const auto cameras = eval::read_pose2sim_cameras(toml);
+    std::cout << "\n"
+              << check_table("## " + std::string(lay->name) +
+                                 ": 2D check, keypoints and reference projected through the " +
+                                 std::to_string(cameras.size()) +
+                                 " Pose2Sim cameras, correction applied in 2D (mm at the joint's "
+                                 "depth)",
+                             eval::evaluate_offsets_2d(fit.offsets, fit_frames, cameras));
+  }
+
+  if (args.has("out")) {
+    std::string header = "Where " + std::string(lay->name) +
+                         " puts its joints relative to the canonical joint centres.\n"
+                         "Produced by: " +
+                         command_line(argc, argv) + "\nData: " + source + "\nModel: " + kModel +
+                         "\n\n" + report.str();
+    const fs::path out = args.get("out");
+    if (out.has_parent_path()) fs::create_directories(out.parent_path());
+    std::ofstream(out) << recon::format_layout_offsets(fit.offsets, header);
+    recon::load_layout_offsets(out);  // what was written reads back
+    std::cout << "\nwrote " << out.string() << "\n";
+  }
+  return 0;
+}
+
+}  // namespace
+
+int calibrate_command(int argc, char** argv) {
+  static constexpr Subcommand kSubcommands[] = {
+      {"layout", "fit where a keypoint layout puts its joints (calibration/layouts/)",
+       layout_command},
+  };
+  return run_subcommand("mocap calibrate", kSubcommands, argc, argv);
+}
+
+}  // namespace mocap::cli
