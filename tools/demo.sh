@@ -1,22 +1,29 @@
 #!/usr/bin/env bash
 # The default job: builds the pose database from the CMU train split beside the repository
-# (../shared/data/mocap/cmu31; or CMU subjects fetched with tools/fetch_cmu.sh), then reconstructs
-# the 3D motion of every player in OpenPose's 750-frame badminton keypoints
-# (../shared/data/eval/openpose_json) and says where the results are.
+# (../shared/data/mocap/cmu31; or CMU subjects fetched with tools/fetch_cmu.sh) when it is missing,
+# then finds every pedestrian of OpenCV's vtest.avi (795 frames, 768x576, from Debian's opencv-doc)
+# with MoveNet, reconstructs their 3D motion and says where the results are.
 #
-#   tools/demo.sh [--out DIR] [--input FOLDER]   defaults: out/, the badminton keypoints
+#   tools/demo.sh [--out DIR] [--input VIDEO|FOLDER] [--detector-size N] [-- more reconstruct options]
+#   defaults: out/, /usr/share/doc/opencv-doc/examples/data/vtest.avi, 384
 set -euo pipefail
 
 repo=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 mocap="$repo/build/bin/mocap"
 db="$repo/build/db/cmu31_train.mdb"
 out="$repo/out"
-input="$repo/../shared/data/eval/openpose_json/json"
+vtest=/usr/share/doc/opencv-doc/examples/data/vtest.avi
+vtest_part="$repo/../shared/data/eval/opencv_samples/vtest_part0.avi"
+input=""
+size=384
+extra=()
 while (( $# )); do
   case "$1" in
     --out) out="$2"; shift 2 ;;
     --input) input="$2"; shift 2 ;;
-    -h|--help) sed -n '2,8p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    --detector-size) size="$2"; shift 2 ;;
+    --) shift; extra=("$@"); break ;;
+    -h|--help) sed -n '2,9p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "demo.sh: unknown option '$1' (see --help)" >&2; exit 2 ;;
   esac
 done
@@ -39,12 +46,24 @@ if [[ ! -f "$db" ]]; then
 fi
 "$mocap" db info "$db"
 echo
-if [[ ! -d "$input" ]]; then
-  echo "demo.sh: no keypoints to reconstruct at $input (give a folder of OpenPose JSON with --input)" >&2
-  exit 1
+
+if [[ -z "$input" ]]; then
+  if [[ -f "$vtest" ]]; then
+    input="$vtest"
+  elif [[ -f "$vtest_part" ]]; then
+    echo "demo.sh: $vtest is missing (Debian package opencv-doc: tools/setup.sh installs it);" >&2
+    echo "         using its first 200 frames from the shared data instead: $vtest_part" >&2
+    input="$vtest_part"
+  else
+    echo "demo.sh: no video to reconstruct: install opencv-doc (tools/setup.sh does) for $vtest," >&2
+    echo "         or give one with --input VIDEO" >&2
+    exit 1
+  fi
 fi
-# The badminton keypoints come from a 1920x1080, 25 fps video (../shared/data/eval/openpose_json/README.md).
-"$mocap" reconstruct "$input" --db "$db" --out "$out" --fps 25 --image-size 1920x1080 --quiet
+[[ -e "$input" ]] || { echo "demo.sh: no such input: $input" >&2; exit 1; }
+echo "reconstructing $input (MoveNet at $size) into $out"
+"$mocap" reconstruct "$input" --db "$db" --out "$out" --detector-size "$size" --quiet "${extra[@]}"
 echo
-echo "Open $out/overlay.mp4 to watch the input beside the 3D result; $out/person_<id>.bvh import into"
-echo "Blender, MotionBuilder or Maya; $out/poses.jsonl has every frame's 15 joints per person."
+echo "Open $out/overlay.mp4 to watch the video with every person's keypoints and id beside their 3D"
+echo "skeletons; $out/person_<id>.bvh import into Blender, MotionBuilder or Maya; $out/poses.jsonl has"
+echo "every frame's 15 joints per person; $out/summary.json the run's numbers."
