@@ -9,6 +9,8 @@
 #include <iostream>
 #include <sstream>
 
+#include <glm/geometric.hpp>
+
 #include "cli_args.hpp"
 #include "commands.hpp"
 #include "core/input_error.hpp"
@@ -87,6 +89,36 @@ std::string check_table(const std::string& title,
   return t.str();
 }
 
+// Mean proportions of the reference bodies (mm), to compare with the database's body.
+std::string proportions(std::span<const eval::CalibrationFrame> frames) {
+  const auto mean_distance = [&](auto&& a, auto&& b) {
+    double sum = 0;
+    int n = 0;
+    for (const auto& f : frames) {
+      const double d = glm::length(a(f.reference) - b(f.reference));
+      if (std::isfinite(d)) sum += d, ++n;
+    }
+    return n ? 1000.0 * sum / n : 0.0;
+  };
+  const auto joint = [](Joint j) { return [j](const eval::Joints3& r) { return r[index(j)]; }; };
+  const auto mid = [](Joint a, Joint b) {
+    return [a, b](const eval::Joints3& r) { return 0.5f * (r[index(a)] + r[index(b)]); };
+  };
+  const auto shoulders = mid(Joint::right_shoulder, Joint::left_shoulder);
+  const auto hips = mid(Joint::right_hip, Joint::left_hip);
+  std::ostringstream t;
+  t << "| hip-mid -> shoulder-mid | shoulders apart | hips apart | thigh | shin | upper arm | "
+       "forearm |\n|---:|---:|---:|---:|---:|---:|---:|\n| "
+    << fixed(mean_distance(shoulders, hips), 0) << " | "
+    << fixed(mean_distance(joint(Joint::right_shoulder), joint(Joint::left_shoulder)), 0) << " | "
+    << fixed(mean_distance(joint(Joint::right_hip), joint(Joint::left_hip)), 0) << " | "
+    << fixed(mean_distance(joint(Joint::right_hip), joint(Joint::right_knee)), 0) << " | "
+    << fixed(mean_distance(joint(Joint::right_knee), joint(Joint::right_ankle)), 0) << " | "
+    << fixed(mean_distance(joint(Joint::right_shoulder), joint(Joint::right_elbow)), 0) << " | "
+    << fixed(mean_distance(joint(Joint::right_elbow), joint(Joint::right_wrist)), 0) << " |\n";
+  return t.str();
+}
+
 std::string command_line(int argc, char** argv) {
   std::string line = "mocap calibrate layout";
   for (int i = 0; i < argc; ++i) line.append(" ").append(argv[i]);
@@ -153,6 +185,8 @@ int layout_command(int argc, char** argv) {
          << " frames; offset = reference - keypoint in the body frame before correction)\n\n"
          << fit_table(fit);
   if (!fit.notes.empty()) report << "\n" << fit.notes;
+  report << "\nProportions of the reference joints (mean, mm; right side):\n\n"
+         << proportions(fit_frames);
   std::cout << report.str();
 
   if (lay->id == LayoutId::humaneva15) {
