@@ -119,6 +119,11 @@ struct Camera::Impl {
   std::optional<std::uint64_t> last_id;  // of the last complete frame
   std::uint64_t incomplete_since_last = 0;
   std::optional<std::int64_t> clock_offset;  // min(arrival - device time), see Camera::next
+  // The stream watchdog (CameraSettings::loss_timeout): when the last buffer (or the start) was.
+  std::chrono::steady_clock::duration loss_timeout{};
+  std::chrono::steady_clock::time_point last_buffer;
+  bool any_buffer = false;
+  std::string loss_reason;  // set by the thread calling next(); the heartbeat sets `lost` only
 
   ~Impl() {
     if (camera && stream && !lost) {
@@ -132,11 +137,14 @@ struct Camera::Impl {
 
   void open(const CameraSettings& settings);
   void install_fake_fill(const FakeFill& fill);
+  ArvFakeCamera* fake_camera();
+  void set_fake_pixel_format(std::uint32_t pfnc);
   void ensure_control();
   static void fill_fake_buffer(ArvBuffer* buffer, void* self, guint32, guint32, ArvPixelFormat);
   void apply(const CameraSettings& settings);
   void start(const CameraSettings& settings);
   std::optional<Frame> take(ArvBuffer* buffer);
+  bool watchdog_expired(std::chrono::steady_clock::time_point now);
   void track_complete_id(std::uint64_t id);
 };
 
@@ -184,13 +192,22 @@ void Camera::Impl::ensure_control() {
   }
 }
 
-void Camera::Impl::install_fake_fill(const FakeFill& fill) {
+ArvFakeCamera* Camera::Impl::fake_camera() {
   ArvDevice* device = arv_camera_get_device(camera.get());
   if (!ARV_IS_FAKE_DEVICE(device))
     throw std::runtime_error("camera '" + label + "' is not Aravis' in-process fake camera");
+  return arv_fake_device_get_fake_camera(ARV_FAKE_DEVICE(device));
+}
+
+void Camera::Impl::install_fake_fill(const FakeFill& fill) {
+  ArvFakeCamera* fake = fake_camera();
   fake_fill = fill;
-  arv_fake_camera_set_fill_pattern(arv_fake_device_get_fake_camera(ARV_FAKE_DEVICE(device)),
-                                   fill_fake_buffer, this);
+  arv_fake_camera_set_fill_pattern(fake, fill_fake_buffer, this);
+}
+
+void Camera::Impl::set_fake_pixel_format(std::uint32_t pfnc) {
+  if (!arv_fake_camera_write_register(fake_camera(), ARV_FAKE_CAMERA_REGISTER_PIXEL_FORMAT, pfnc))
+    throw std::runtime_error("camera '" + label + "': cannot write the fake pixel format");
 }
 
 // Called by the fake camera for every frame, on its streaming thread, after it has set the
@@ -207,7 +224,9 @@ void Camera::Impl::fill_fake_buffer(ArvBuffer* buffer, void* self, guint32, guin
 void Camera::Impl::apply(const CameraSettings& settings) {
   ErrorSlot error;
   ArvCamera* cam = camera.get();
-  if (!settings.pixel_format.empty()) {
+  if (settings.fake_pixel_format != 0) {
+    set_fake_pixel_format(settings.fake_pixel_format);  // instead of settings.pixel_format
+  } else if (!settings.pixel_format.empty()) {
     arv_camera_set_pixel_format_from_string(cam, settings.pixel_format.c_str(), error.out());
     error.throw_if_failed(label, "cannot set pixel format " + settings.pixel_format);
   }
@@ -215,10 +234,11 @@ void Camera::Impl::apply(const CameraSettings& settings) {
   error.throw_if_failed(label, "cannot read the pixel format");
   const auto supported = camera_format_from_code(pfnc);
   if (!supported) {
-    throw std::runtime_error("camera '" + label + "': pixel format " +
-                             text(arv_camera_get_pixel_format_as_string(cam, error.out())) + " (" +
-                             describe_pfnc(pfnc) +
-                             ") is not supported; use Mono8, Bayer*8, RGB8, BGR8 or YUV422");
+    throw std::runtime_error(
+        "camera '" + label + "': pixel format " +
+        text(arv_camera_get_pixel_format_as_string(cam, error.out())) + " (" + describe_pfnc(pfnc) +
+        ") is not supported; use Mono8/10/12/14/16 (also packed), Bayer*8/10/12/16 "
+        "(also packed), RGB8, BGR8 or YUV422");
   }
   format = *supported;
   if (settings.region) {
@@ -260,6 +280,13 @@ void Camera::Impl::start(const CameraSettings& settings) {
   error.throw_if_failed(label, "cannot set continuous acquisition");
   arv_camera_start_acquisition(cam, error.out());
   error.throw_if_failed(label, "cannot start acquisition");
+  if (settings.loss_timeout.count() > 0) {
+    const double period_ms = rate > 0 ? 1000.0 / rate : 0.0;
+    loss_timeout = std::max<std::chrono::steady_clock::duration>(
+        settings.loss_timeout,
+        std::chrono::milliseconds(static_cast<std::int64_t>(std::ceil(10 * period_ms))));
+  }
+  last_buffer = std::chrono::steady_clock::now();
 }
 
 // Only complete frames' ids are trusted (a buffer that lost its leader may carry any id). Between
@@ -345,19 +372,42 @@ std::optional<Frame> Camera::next(std::chrono::milliseconds timeout) {
   using Clock = std::chrono::steady_clock;
   const auto deadline = Clock::now() + timeout;
   while (!impl_->lost) {
-    const auto left =
-        std::chrono::duration_cast<std::chrono::microseconds>(deadline - Clock::now()).count();
+    const auto now = Clock::now();
+    if (impl_->watchdog_expired(now)) return std::nullopt;
+    const auto left = std::chrono::duration_cast<std::chrono::microseconds>(deadline - now).count();
     if (left <= 0) return std::nullopt;
     ArvBuffer* buffer =
         arv_stream_timeout_pop_buffer(impl_->stream.get(), static_cast<guint64>(left));
-    if (!buffer) return std::nullopt;
+    if (!buffer) continue;  // the loop checks the watchdog, then the deadline
+    impl_->last_buffer = Clock::now();
+    impl_->any_buffer = true;
     const BufferReturn giveback{impl_->stream.get(), buffer};
     if (auto frame = impl_->take(buffer)) return frame;
   }
   return std::nullopt;
 }
 
+// The stream watchdog: true (and the camera lost) when no buffer came for loss_timeout.
+bool Camera::Impl::watchdog_expired(std::chrono::steady_clock::time_point now) {
+  if (loss_timeout.count() == 0) return false;
+  const auto limit =
+      loss_timeout + (any_buffer ? std::chrono::seconds(0) : std::chrono::seconds(2));
+  if (now - last_buffer < limit) return false;
+  loss_reason =
+      "no data for " +
+      std::to_string(
+          std::chrono::duration_cast<std::chrono::milliseconds>(now - last_buffer).count()) +
+      " ms";
+  lost = true;
+  return true;
+}
+
 bool Camera::control_lost() const { return impl_->lost; }
+
+std::string Camera::loss_reason() const {
+  if (!impl_->lost) return "";
+  return impl_->loss_reason.empty() ? "control-lost: the heartbeat failed" : impl_->loss_reason;
+}
 
 StreamCounters Camera::counters() const {
   StreamCounters counters = impl_->counters;

@@ -36,10 +36,18 @@ struct CameraSettings {
   std::optional<double> gain;    // none: leave it
   std::string pixel_format;      // GenICam name (Mono8, BayerRG8, ...); empty: leave it
   int buffers = 0;               // stream buffers; 0: half a second of frames (4..64)
+  // No buffer at all (whole or not) for this long, once streaming: the camera counts as lost, as
+  // when its heartbeat fails, but sooner (Aravis notices a GigE camera gone after about 14 s). At
+  // least 10 frame periods; the first frame may take 2 s more. 0: only the heartbeat.
+  std::chrono::milliseconds loss_timeout{0};
   // Only for Aravis' in-process fake camera (enable_fake_interface): writes the pixels of every
   // frame, on Aravis' streaming thread, so tests can send their own images through the camera
   // path. Opening any other camera with it set fails.
   std::function<void(std::span<std::byte> pixels, int width, int height)> fake_fill;
+  // Only for the in-process fake camera: a PFNC code written straight into its pixel format
+  // register (its GenICam file lists Mono8, Mono16, Bayer*8 and RGB8 only), so that tests can
+  // stream the other formats (YUV422, Mono12p, ...) end to end. 0: not used.
+  std::uint32_t fake_pixel_format = 0;
 };
 
 struct Frame {
@@ -72,7 +80,9 @@ class Camera {
   // exact and the minimum offset is the arrival with the least transport delay.
   std::optional<Frame> next(std::chrono::milliseconds timeout);
 
-  bool control_lost() const;  // the camera stopped answering (heartbeat failed)
+  // The camera stopped answering: its heartbeat failed, or nothing arrived for loss_timeout.
+  bool control_lost() const;
+  std::string loss_reason() const;  // why control_lost() is true ("" while it is not)
   StreamCounters counters() const;
   const DeviceInfo& info() const;
   std::string pixel_format() const;  // the camera's GenICam name of its current format

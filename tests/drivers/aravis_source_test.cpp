@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <functional>
+#include <iostream>
 #include <mutex>
 #include <thread>
 
@@ -119,8 +120,16 @@ TEST_F(AravisSourceTest, ACameraThatCannotBeOpenedFailsTheGraphNamingIt) {
   EXPECT_NE(result.error.find("no-such-camera-4711"), std::string::npos) << result.error;
 }
 
-// The camera dies mid-stream and comes back: the node reconnects and the stream goes on, with
-// seq and frame still counting up from where they were.
+std::string status_of(const Runtime& runtime, const std::string& node) {
+  for (const NodeStats& s : runtime.stats().nodes) {
+    if (s.node == node) return s.status;
+  }
+  return "";
+}
+
+// The camera dies mid-stream and comes back: the node notices within its loss timeout (1 s of
+// no data here, not Aravis' heartbeat), says so in its status line in the graph's statistics,
+// reconnects, and the stream goes on, with seq and frame still counting up from where they were.
 TEST_F(AravisSourceTest, ReconnectsWhenTheCameraComesBack) {
   const std::string serial = test::unique_serial("NODE");
   auto fake = std::make_unique<test::FakeGvCamera>(*program_, serial);
@@ -129,18 +138,33 @@ TEST_F(AravisSourceTest, ReconnectsWhenTheCameraComesBack) {
   ::testing::internal::CaptureStderr();
   std::thread graph([&] { result = runtime.run(); });
   const bool first = wait_until([] { return seen_count() >= 5; }, 15s);
-  fake.reset();  // killed: the heartbeat fails and the node reports control-lost
+  const std::string before_status = status_of(runtime, "cam");
+  fake.reset();  // killed: no more data; the watchdog reports the camera lost
+  const auto killed = std::chrono::steady_clock::now();
   const std::size_t before = seen_count();
-  std::this_thread::sleep_for(1s);
+  const bool noticed =
+      wait_until([&] { return status_of(runtime, "cam").find("lost") != std::string::npos; }, 30s);
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - killed).count();
+  const std::string lost_status = status_of(runtime, "cam");
   fake = std::make_unique<test::FakeGvCamera>(*program_, serial);
   const bool again = wait_until([&] { return seen_count() >= before + 5; }, 60s);
+  const std::string after_status = status_of(runtime, "cam");
   runtime.request_stop();
   graph.join();
   const std::string log = ::testing::internal::GetCapturedStderr();
-  EXPECT_NE(log.find("lost (control-lost)"), std::string::npos) << log;
+  std::cout << "[ measured ] source.aravis noticed the dead camera after " << seconds << " s\n";
+  RecordProperty("node_loss_s", std::to_string(seconds));
+  EXPECT_NE(log.find("lost (no data for"), std::string::npos) << log;
   EXPECT_NE(log.find("reconnected to camera"), std::string::npos) << log;
   ASSERT_TRUE(first) << "no frames before the camera was killed";
+  EXPECT_NE(before_status.find("streaming from"), std::string::npos) << before_status;
+  ASSERT_TRUE(noticed) << "the status never said the camera was lost";
+  EXPECT_LT(seconds, 3.0) << lost_status;  // loss_timeout_ms 1000 (the default)
+  EXPECT_NE(lost_status.find("[1 lost, 0 reconnects]"), std::string::npos) << lost_status;
   ASSERT_TRUE(again) << "no frames after the camera came back";
+  EXPECT_NE(after_status.find("reconnected to camera"), std::string::npos) << after_status;
+  EXPECT_NE(after_status.find("[1 lost, 1 reconnects]"), std::string::npos) << after_status;
   EXPECT_TRUE(result.ok) << result.error;
   const std::lock_guard lock(seen_mutex);
   for (std::size_t i = 0; i < seen.size(); ++i) EXPECT_EQ(seen[i].header.seq, i);

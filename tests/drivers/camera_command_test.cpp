@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
 
 #include "fake_gv_camera.hpp"
 #include "support/mocap_process.hpp"
@@ -28,12 +30,39 @@ TEST_F(CameraCommandTest, ListShowsTheFakeCamera) {
   EXPECT_NE(out.find("Aravis"), std::string::npos) << out;
 }
 
-TEST_F(CameraCommandTest, GrabSavesFramesAndPrintsTheRate) {
+TEST_F(CameraCommandTest, GrabSavesPngFramesByDefault) {
+  FakeGvCamera fake(*program_, unique_serial("CLI"));
+  const auto out_dir = dir_.path() / "png";
+  Mocap grab(dir_, "grab",
+             {"camera", "grab", "--id", fake.serial(), "--frames", "3", "--out", out_dir.string(),
+              "--width", "64", "--height", "48", "--fps", "50", "--pixel-format", "Mono16"});
+  ASSERT_EQ(grab.wait(60s), 0) << grab.err();
+  EXPECT_NE(grab.out().find("grabbed 3 frames"), std::string::npos) << grab.out();
+  for (int i = 0; i < 3; ++i) {
+    const auto file = out_dir / ("frame_00000" + std::to_string(i) + ".png");
+    const cv::Mat image = cv::imread(file.string(), cv::IMREAD_UNCHANGED);
+    ASSERT_FALSE(image.empty()) << file << " is not a PNG OpenCV reads";
+    EXPECT_EQ(image.cols, 64);
+    EXPECT_EQ(image.rows, 48);
+    EXPECT_EQ(image.type(), CV_8UC1) << "Mono16 is saved as its top 8 bits";
+  }
+  Mocap colour(dir_, "colour",
+               {"camera", "grab", "--id", fake.serial(), "--frames", "1", "--out",
+                (dir_.path() / "rgb").string(), "--width", "64", "--height", "48", "--pixel-format",
+                "BayerRG8"});
+  ASSERT_EQ(colour.wait(60s), 0) << colour.err();
+  const cv::Mat rgb = cv::imread((dir_.path() / "rgb" / "frame_000000.png").string());
+  ASSERT_FALSE(rgb.empty());
+  EXPECT_EQ(rgb.type(), CV_8UC3);
+}
+
+TEST_F(CameraCommandTest, GrabSavesPnmFramesAndPrintsTheRate) {
   FakeGvCamera fake(*program_, unique_serial("CLI"));
   const auto out_dir = dir_.path() / "frames";
   Mocap grab(dir_, "grab",
              {"camera", "grab", "--id", fake.serial(), "--frames", "5", "--out", out_dir.string(),
-              "--width", "64", "--height", "48", "--fps", "50", "--pixel-format", "Mono8"});
+              "--width", "64", "--height", "48", "--fps", "50", "--pixel-format", "Mono8",
+              "--format", "pnm"});
   ASSERT_EQ(grab.wait(60s), 0) << grab.err();
   EXPECT_NE(grab.out().find("grabbed 5 frames"), std::string::npos) << grab.out();
   EXPECT_NE(grab.out().find("drops: "), std::string::npos) << grab.out();

@@ -1,5 +1,5 @@
 // `mocap camera list|grab`: the GigE Vision / USB3 Vision cameras Aravis sees, and a quick grab
-// to files (PGM for grey, PPM for colour: readable everywhere, no image library needed).
+// to files: PNG (OpenCV's imwrite, the default) or PGM/PPM (grey/colour, written directly).
 
 #include <chrono>
 #include <cstdio>
@@ -8,6 +8,9 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "camera.hpp"
 #include "cli_args.hpp"
@@ -54,6 +57,18 @@ void write_netpbm(const ImageBuffer& image, const std::filesystem::path& path) {
   if (!out.flush()) throw std::runtime_error("cannot write " + path.string());
 }
 
+// PNG through OpenCV: grey as 8-bit grey, colour as RGB (OpenCV wants BGR in memory).
+void write_png(const ImageBuffer& image, const std::filesystem::path& path) {
+  const bool grey = image.format() == PixelFormat::gray8;
+  const cv::Mat view(image.height(), image.width(), grey ? CV_8UC1 : CV_8UC3,
+                     const_cast<std::byte*>(image.data()),
+                     static_cast<std::size_t>(image.stride()));
+  cv::Mat bgr;
+  if (image.format() == PixelFormat::rgb8) cv::cvtColor(view, bgr, cv::COLOR_RGB2BGR);
+  if (!cv::imwrite(path.string(), bgr.empty() ? view : bgr))
+    throw std::runtime_error("cannot write " + path.string());
+}
+
 aravis::CameraSettings settings_from(const Args& args) {
   aravis::CameraSettings s;
   s.id = args.get("id");
@@ -84,11 +99,13 @@ void print_summary(const aravis::Camera& camera, long frames, std::int64_t first
 
 int grab(int argc, char** argv) {
   Args args("mocap camera grab --frames N --out DIR [--id ID] [options]",
-            "Grabs N frames from a camera into DIR as PGM (grey) or PPM (colour) files and prints "
-            "the achieved frame rate and the drops.");
+            "Grabs N frames from a camera into DIR as PNG (or PGM/PPM) files and prints the "
+            "achieved frame rate and the drops. Formats of more than 8 bits are saved as their "
+            "top 8 bits.");
   args.option("id", "ID", "camera id, serial or address (default: the first found)", "")
       .option("frames", "N", "frames to save", "10")
-      .option("out", "DIR", "folder for frame_000000.pgm|ppm ...")
+      .option("out", "DIR", "folder for frame_000000.png ...")
+      .option("format", "png|pnm", "png, or pnm: PGM for grey, PPM for colour", "png")
       .option("fps", "F", "frame rate (0: the camera's)", "0")
       .option("x", "N", "region left", "0")
       .option("y", "N", "region top", "0")
@@ -107,6 +124,8 @@ int grab(int argc, char** argv) {
   const std::filesystem::path out = args.get("out");
   std::filesystem::create_directories(out);
   const auto timeout = std::chrono::milliseconds(args.integer("timeout-ms"));
+  const std::string format = args.get("format");
+  if (format != "png" && format != "pnm") throw InputError("--format", "expected png or pnm");
 
   aravis::Camera camera(settings_from(args));
   const auto region = camera.region();
@@ -125,9 +144,15 @@ int grab(int argc, char** argv) {
     if (i == 0) first_ns = frame->capture_ns;
     last_ns = frame->capture_ns;
     char name[32];
-    std::snprintf(name, sizeof name, "frame_%06ld.%s", i,
-                  frame->image.format() == PixelFormat::gray8 ? "pgm" : "ppm");
-    write_netpbm(frame->image, out / name);
+    const char* extension = format == "png"                               ? "png"
+                            : frame->image.format() == PixelFormat::gray8 ? "pgm"
+                                                                          : "ppm";
+    std::snprintf(name, sizeof name, "frame_%06ld.%s", i, extension);
+    if (format == "png") {
+      write_png(frame->image, out / name);
+    } else {
+      write_netpbm(frame->image, out / name);
+    }
   }
   const double wall_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -1,10 +1,13 @@
 // source.aravis: frames from a GigE Vision / USB3 Vision camera through Aravis (drivers/aravis).
-// A camera that stops answering ("control-lost") is reported and reopened, with the same
-// settings, whenever it comes back; the graph keeps running meanwhile.
+// A camera that stops answering (no data for loss_timeout_ms, or Aravis' heartbeat failed) is
+// reported, on stderr and as the node's status line in the graph's statistics, and reopened with
+// the same settings whenever it comes back; the graph keeps running meanwhile.
 
 #include <cmath>
 #include <iostream>
-#include <optional>
+#include <memory>
+#include <thread>
+#include <vector>
 
 #include "camera.hpp"
 #include "graph/registry.hpp"
@@ -29,14 +32,19 @@ class AravisSource : public Node {
     c.param<std::int64_t>("buffers", 0, "stream buffers (0: half a second of frames)", {0, 1024});
     c.param<std::int64_t>("count", 0, "frames before end of stream (0: until stopped)", {0, 1e12});
     c.param<std::int64_t>("camera", 0, "camera id in the messages", {0, 1000});
+    c.param<double>("loss_timeout_ms", 1000.0,
+                    "no data for this long (at least 10 frame periods): the camera is lost and "
+                    "reopened; 0: only Aravis' heartbeat (about 14 s)",
+                    {0, 3.6e6});
   }
 
   void open(Context& ctx) override {
     settings_ = settings_from(ctx);
     count_ = ctx.param<std::uint64_t>("count");
     camera_id_ = ctx.param<int>("camera");
-    camera_.emplace(settings_);  // throws naming the camera: the graph fails to start
+    camera_ = std::make_unique<aravis::Camera>(settings_);  // throws naming the camera
     report_open(ctx, "streaming from");
+    ctx.report_status("streaming from '" + camera_->info().id + "'");
   }
 
   void process(Context& ctx) override {
@@ -67,6 +75,8 @@ class AravisSource : public Node {
     if (const double gain = ctx.param<double>("gain"); gain >= 0) s.gain = gain;
     s.pixel_format = ctx.param<std::string>("pixel_format");
     s.buffers = ctx.param<int>("buffers");
+    s.loss_timeout = std::chrono::milliseconds(
+        static_cast<std::int64_t>(std::llround(ctx.param<double>("loss_timeout_ms"))));
     return s;
   }
 
@@ -99,33 +109,43 @@ class AravisSource : public Node {
   }
 
   void lose(Context& ctx) {
-    std::cerr << ctx.node_name() << ": camera '" << camera_->info().id
-              << "' lost (control-lost); reconnecting\n";
+    const std::string what =
+        "camera '" + camera_->info().id + "' lost (" + camera_->loss_reason() + "); reconnecting";
+    std::cerr << ctx.node_name() << ": " << what << "\n";
+    ++losses_;
+    ctx.report_status(what + " [" + std::to_string(losses_) + " lost, " +
+                      std::to_string(reconnects_) + " reconnects]");
     base_incomplete_ = incomplete_;
     base_skipped_ = skipped_;
     seen_drops_ = 0;
-    camera_.reset();
+    // Closing a camera that no longer answers waits for Aravis' timeouts (about 10 s on GigE):
+    // that happens on its own thread, so the reconnection attempts start at once.
+    closing_.emplace_back([camera = std::move(camera_)]() mutable { camera.reset(); });
   }
 
   // One attempt per call; between attempts the node sleeps (waking early when the graph stops).
   bool reconnect(Context& ctx) {
     try {
-      camera_.emplace(settings_);
+      camera_ = std::make_unique<aravis::Camera>(settings_);
     } catch (const std::runtime_error&) {
       ctx.sleep_for(std::chrono::milliseconds(500));
       return false;
     }
     ++reconnects_;
     report_open(ctx, "reconnected to");
+    ctx.report_status("reconnected to camera '" + camera_->info().id + "' [" +
+                      std::to_string(losses_) + " lost, " + std::to_string(reconnects_) +
+                      " reconnects]");
     return true;
   }
 
   aravis::CameraSettings settings_;
-  std::optional<aravis::Camera> camera_;
+  std::unique_ptr<aravis::Camera> camera_;
+  std::vector<std::jthread> closing_;  // lost cameras being closed; joined when the node goes
   std::uint64_t count_ = 0, seq_ = 0;
   int camera_id_ = 0;
   std::uint64_t seen_drops_ = 0, incomplete_ = 0, skipped_ = 0, base_incomplete_ = 0,
-                base_skipped_ = 0, reconnects_ = 0;
+                base_skipped_ = 0, reconnects_ = 0, losses_ = 0;
 };
 
 MOCAP_REGISTER_NODE("source.aravis", AravisSource)
