@@ -58,6 +58,15 @@ TEST(DbCommand, SplitTakesFoldersWithoutSplitsWholeAndRecordsFamiliesAndBody) {
   EXPECT_NE(text.out().find("body         canonical"), std::string::npos) << text.out();
   EXPECT_NE(text.out().find("bandai"), std::string::npos) << text.out();
 
+  // cmu_daz holds trials of the held-out subjects: a database with them says so.
+  fs::create_directories(dir.path() / "daz");
+  fs::copy_file(mocap / "cmu_daz/07_01.bvh", dir.path() / "daz/07_01.bvh");
+  test::Mocap daz(dir, "daz",
+                  {"db", "build", dir.file("daz"), "--yaw-steps", "2", "--heights", "1.5",
+                   "--clusters", "4", "--out", dir.file("daz.mdb")});
+  EXPECT_EQ(daz.wait(120s), 0) << daz.err();
+  EXPECT_NE(daz.err().find("held-out"), std::string::npos) << daz.err();
+
   test::Mocap bad(dir, "bad-body",
                   {"db", "build", dir.file("cmu"), "--body", "giant", "--out", dir.file("x.mdb")});
   EXPECT_EQ(bad.wait(60s), 1);

@@ -141,6 +141,11 @@ int build(int argc, char** argv) {
   posedb::write_database(db, args.get("out"));
   bar.finish();
   for (const auto& s : report.skipped) std::cerr << "skipped: " << s << "\n";
+  if (std::any_of(db.clips.begin(), db.clips.end(),
+                  [](const posedb::ClipInfo& c) { return c.family == "cmu_daz"; })) {
+    std::cerr << "warning: cmu_daz clips are in this database; they are trials of the held-out "
+                 "CMU subjects, so do not evaluate with it\n";
+  }
   std::cout << "wrote " << args.get("out") << ": " << db.clips.size() << " clips, "
             << db.frames.size() << " frames, " << db.views.size() << " views, "
             << db.projection_records.size() << " projections, " << db.cluster_begin.size() - 1
