@@ -219,6 +219,12 @@ TEST_F(RemoteKeypointsTest, KeypointsFromPythonArriveAsSentAndGarbageIsCounted) 
     for (const auto& message : garbage()) sender.send(message);
   }
   ASSERT_TRUE(run.wait_for_log("rejected message (7)", 30s)) << run.err();
+  {
+    // Beyond ZeroMQ's 16 MiB limit of the node: that sender is disconnected (not counted), and
+    // the node goes on.
+    Socket huge(ZMQ_PUSH, in);
+    huge.send({std::string(17u << 20, 'x')});
+  }
   EXPECT_TRUE(run.wait_for_log("rejected message 1: .* from 127\\.0\\.0\\.1 on " + in, 1s))
       << run.err();
 
