@@ -1,0 +1,129 @@
+// `mocap reconstruct VIDEO` end to end, through the built binary: the first frames of the shared
+// vtest video become poses.jsonl (one line per frame, its time in the video), BVH files, an
+// overlay video and a summary; a missing model, a truncated or unreadable video and an absent
+// camera each end the run with exit code 1 and a message naming the problem.
+
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "detect/model_files.hpp"
+#include "support/mocap_process.hpp"
+#include "support/shared_data.hpp"
+
+namespace mocap {
+namespace {
+
+namespace fs = std::filesystem;
+using namespace std::chrono_literals;
+
+const fs::path kVideo = test::shared_data() / "eval" / "opencv_samples" / "vtest_part0.avi";
+
+class ReconstructVideoTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    const fs::path mocap = test::shared_data() / "mocap" / "cmu31";
+    if (!fs::exists(mocap / "08_01.bvh") || !fs::exists(kVideo)) return;
+    dir_ = std::make_unique<test::TempDir>();
+    test::Mocap build(
+        *dir_, "build",
+        {"db", "build", (mocap / "08_01.bvh").string(), (mocap / "09_12.bvh").string(),
+         "--clusters", "32", "--out", dir_->file("db.mdb")});
+    ASSERT_EQ(build.wait(120s), 0) << build.err();
+  }
+  static void TearDownTestSuite() { dir_.reset(); }
+  void SetUp() override {
+    if (!dir_) GTEST_SKIP() << "shared data absent (../shared/data/mocap/cmu31, " << kVideo << ")";
+  }
+  static test::Mocap reconstruct(const std::string& name, const std::string& input,
+                                 std::vector<std::string> extra = {},
+                                 std::vector<std::string> env = {}) {
+    std::vector<std::string> args = {"reconstruct",        input,   "--db",
+                                     dir_->file("db.mdb"), "--out", dir_->file(name)};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return test::Mocap(*dir_, name, args, std::move(env));
+  }
+  static inline std::unique_ptr<test::TempDir> dir_;
+};
+
+bool model_present() {
+  try {
+    detect::movenet_model_json();
+    return true;
+  } catch (const detect::ModelMissing&) {
+    return false;
+  }
+}
+
+TEST_F(ReconstructVideoTest, AVideoBecomesPosesBvhAndAnOverlayVideo) {
+  if (!model_present()) GTEST_SKIP() << "MoveNet model absent: tools/setup.sh --models-only";
+  auto run =
+      reconstruct("out", kVideo.string(), {"--detector-size", "384", "--set", "src.count=30"});
+  ASSERT_EQ(run.wait(300s), 0) << run.err();
+  const std::string out = dir_->file("out");
+  const auto lines = test::read_lines(out + "/poses.jsonl");
+  ASSERT_EQ(lines.size(), 30u);
+  std::size_t people = 0;
+  for (std::size_t i = 0; i < lines.size(); ++i) {
+    const auto j = nlohmann::json::parse(lines[i]);
+    EXPECT_EQ(j.at("frame").get<std::size_t>(), i);
+    EXPECT_NEAR(j.at("time").get<double>(), 0.1 * static_cast<double>(i), 0.011);  // 10 fps
+    people += j.at("people").size();
+  }
+  EXPECT_GT(people, 30u);  // pedestrians are found: more than one per frame on average
+  EXPECT_GT(fs::file_size(out + "/overlay.mp4"), 10000u);
+  bool bvh = false;
+  for (const auto& e : fs::directory_iterator(out)) bvh = bvh || e.path().extension() == ".bvh";
+  EXPECT_TRUE(bvh);
+  const auto summary = nlohmann::json::parse(test::read_file(out + "/summary.json"));
+  EXPECT_EQ(summary.at("video").at("width"), 768);
+  EXPECT_EQ(summary.at("video").at("height"), 576);
+  EXPECT_EQ(summary.at("detector_size"), 384);
+  EXPECT_EQ(summary.at("frames"), 30);
+  EXPECT_NE(run.out().find(out + "/overlay.mp4"), std::string::npos) << run.out();
+}
+
+TEST_F(ReconstructVideoTest, AMissingModelNamesTheSetupCommand) {
+  auto run = reconstruct("nomodel", kVideo.string(), {}, {"MOCAP_MODEL_DIR=/nonexistent"});
+  ASSERT_EQ(run.wait(60s), 1) << run.err();
+  EXPECT_NE(run.err().find("tools/setup.sh --models-only"), std::string::npos) << run.err();
+}
+
+TEST_F(ReconstructVideoTest, ATruncatedVideoEndsWithAnErrorNamingIt) {
+  if (!model_present()) GTEST_SKIP() << "MoveNet model absent: tools/setup.sh --models-only";
+  const std::string cut = dir_->file("cut.avi");
+  const std::string bytes = test::read_file(kVideo.string());
+  test::write_file(cut, bytes.substr(0, bytes.size() / 10));
+  auto run = reconstruct("cut", cut);
+  ASSERT_EQ(run.wait(300s), 1) << run.err();
+  EXPECT_NE(run.err().find(cut), std::string::npos) << run.err();
+  EXPECT_NE(run.err().find("truncated"), std::string::npos) << run.err();
+  // The frames before the cut are written, and the files are complete.
+  const auto lines = test::read_lines(dir_->file("cut") + "/poses.jsonl");
+  EXPECT_GT(lines.size(), 5u);
+  for (const auto& line : lines)
+    EXPECT_FALSE(nlohmann::json::parse(line, nullptr, false).is_discarded()) << line;
+}
+
+TEST_F(ReconstructVideoTest, UnreadableInputsAndAnAbsentCameraAreRefusedByName) {
+  const std::string noise = dir_->file("noise.avi");
+  std::string bytes(100000, '\0');
+  for (std::size_t i = 0; i < bytes.size(); ++i) bytes[i] = static_cast<char>((i * 7919) % 251);
+  test::write_file(noise, bytes);
+  auto garbage = reconstruct("noise", noise);
+  ASSERT_EQ(garbage.wait(60s), 1) << garbage.err();
+  EXPECT_NE(garbage.err().find(noise), std::string::npos) << garbage.err();
+
+  if (!fs::exists("/dev/video9")) {
+    auto camera = reconstruct("camera", "/dev/video9");
+    ASSERT_EQ(camera.wait(60s), 1) << camera.err();
+    EXPECT_NE(camera.err().find("/dev/video9: no such camera device"), std::string::npos)
+        << camera.err();
+  }
+  auto missing = reconstruct("missing", dir_->file("nothing.mp4"));
+  ASSERT_EQ(missing.wait(60s), 1) << missing.err();
+  EXPECT_NE(missing.err().find("no such file"), std::string::npos) << missing.err();
+}
+
+}  // namespace
+}  // namespace mocap
