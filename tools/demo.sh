@@ -9,7 +9,7 @@
 set -euo pipefail
 
 repo=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
-mocap="$repo/build/bin/mocap"
+mocap="${MOCAP_BIN:-$repo/build/bin/mocap}"  # MOCAP_BIN: another build of it
 db="$repo/build/db/cmu31_train.mdb"
 out="$repo/out"
 vtest=/usr/share/doc/opencv-doc/examples/data/vtest.avi

@@ -308,7 +308,18 @@ int reconstruct_command(int argc, char** argv) {
   std::sort(written.begin(), written.end(), [](const std::string& a, const std::string& b) {
     return a.size() != b.size() ? a.size() < b.size() : a < b;  // person_2 before person_10
   });
-  for (const std::string& file : written) std::cout << "wrote " << file << "\n";
+  // Many people: the BVH files in one line, not one line each.
+  std::size_t bvh = 0;
+  for (const std::string& file : written) {
+    if (written.size() > 8 && file.ends_with(".bvh")) {
+      ++bvh;
+    } else {
+      std::cout << "wrote " << file << "\n";
+    }
+  }
+  if (bvh > 0)
+    std::cout << "wrote " << bvh
+              << " BVH files, one per person: " << (out / "person_<id>.bvh").string() << "\n";
   std::cout << "wrote " << (out / "summary.json").string() << "\n";
   if (!result.ok) {
     std::cerr << "mocap reconstruct: " << result.error << "\n";
