@@ -5,7 +5,7 @@
 # with MoveNet, reconstructs their 3D motion and says where the results are.
 #
 #   tools/demo.sh [--out DIR] [--input VIDEO|FOLDER] [--detector-size N] [-- more reconstruct options]
-#   defaults: out/, /usr/share/doc/opencv-doc/examples/data/vtest.avi, 384
+#   defaults: out/, /usr/share/doc/opencv-doc/examples/data/vtest.avi, 512 (its people are small)
 set -euo pipefail
 
 repo=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
@@ -15,7 +15,7 @@ out="$repo/out"
 vtest=/usr/share/doc/opencv-doc/examples/data/vtest.avi
 vtest_part="$repo/../shared/data/eval/opencv_samples/vtest_part0.avi"
 input=""
-size=384
+size=512
 extra=()
 while (( $# )); do
   case "$1" in
