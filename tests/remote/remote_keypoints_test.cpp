@@ -303,5 +303,11 @@ TEST_F(RemoteKeypointsTest, SilenceEndsTheStreamAfterTheTimeout) {
   EXPECT_NE(run.err().find("no message for 300 ms"), std::string::npos) << run.err();
 }
 
+TEST(RemoteKeypointsGraph, Validates) {
+  TempDir dir;
+  Mocap validate(dir, "validate", {"graph", "validate", "graphs/remote_keypoints.yaml"});
+  ASSERT_EQ(validate.wait(30s), 0) << validate.err() << validate.out();
+}
+
 }  // namespace
 }  // namespace mocap::test
