@@ -91,7 +91,7 @@ def read_openpose_file(path):
         flat = person.get("pose_keypoints_2d", [])
         if not flat:
             continue
-        if len(flat) % 3 != 0:
+        if not isinstance(flat, list) or len(flat) % 3 != 0:
             raise ValueError("people[%d].pose_keypoints_2d is not x, y, c triples" % index)
         values = [float(v) if isinstance(v, (int, float)) else NAN for v in flat]
         pid = person.get("person_id", -1)
@@ -110,7 +110,7 @@ def read_openpose_folder(folder):
     for number, name in files:
         try:
             yield number, read_openpose_file(os.path.join(folder, name))
-        except (OSError, ValueError, UnicodeDecodeError) as e:
+        except (OSError, ValueError, TypeError, AttributeError) as e:
             print("send_keypoints.py: %s: %s; sent without people" % (name, e), file=sys.stderr)
             yield number, []
 
