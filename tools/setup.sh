@@ -35,6 +35,7 @@ packages=(
   build-essential cmake ninja-build ccache pkg-config   # the toolchain
   libgtest-dev libgmock-dev libbenchmark-dev            # tests and benchmarks
   libglm-dev                                            # vectors and quaternions
+  libceres-dev                                          # skeleton fitting (components/fit)
   nlohmann-json3-dev zlib1g-dev                         # JSON files; CRC-32 of the database file
   libflann-dev liblz4-dev                               # FLANN nearest-neighbour search
   libfaiss-dev libblas-dev liblapack-dev                # FAISS search (measured against FLANN)

@@ -1,0 +1,71 @@
+#pragma once
+// Internal to mocap_fit: the variables and constant data of the frames of a window, and the one
+// function that builds and solves the Ceres problem over them (window_problem.cpp, the only file
+// that includes Ceres besides nothing else). Not part of the library's interface.
+
+#include <array>
+#include <span>
+
+#include <glm/vec3.hpp>
+
+#include "fit/skeleton_fit.hpp"
+
+namespace mocap::fit::detail {
+
+inline constexpr int kBones = kBodyJoints - 1;  // bone j (j < 14) ends at joint j
+static_assert(index(Joint::root) == kBones, "the root must be the last joint");
+
+// The bones from the root out to joint j (at most 4), outermost last.
+struct Chain {
+  int length = 0;
+  std::array<int, 4> bone{};
+};
+Chain chain_to(int joint);
+
+// A frame's variables: root translation (camera frame) and the rotation (angle-axis) of every
+// bone away from its reference direction.
+struct FrameVars {
+  std::array<double, 3> t{};
+  std::array<std::array<double, 3>, kBones> w{};
+};
+
+// A frame's constants.
+struct FrameData {
+  bool observed = false;                           // retrieved pose and keypoints present
+  std::array<std::array<double, 3>, kBones> d0{};  // reference bone directions (unit, camera)
+  recon::BodyXyc keypoints{};
+  double sigma_px = 0.0;  // one reprojection sigma in pixels (0: no reprojection term)
+  std::array<bool, 2> contact{};
+  bool has_start = false;           // the closed-form translation exists
+  std::array<double, 3> start_t{};  // closed-form root translation (camera frame)
+  std::array<double, 9> rotation{1, 0, 0, 0, 1, 0, 0, 0, 1};  // camera -> world, row-major
+  std::array<double, 3> position{};                           // camera centre in the world
+};
+
+using Bones = std::array<double, kBones>;
+
+struct WindowFrame {
+  FrameVars* vars;
+  const FrameData* data;
+  bool constant;  // frozen: anchors the terms of its neighbours, not solved
+};
+
+struct WindowSolve {
+  bool solve_bones = false;
+  int max_iterations = 20;
+};
+
+struct WindowSummary {
+  int iterations = 0;
+  double initial_cost = 0.0, final_cost = 0.0;
+};
+
+// Builds the problem over `frames` (time order; constant frames first) and solves it in place.
+WindowSummary solve_window(std::span<const WindowFrame> frames, Bones& bones,
+                           const Bones& initial_bones, const FitOptions& options,
+                           const WindowSolve& solve);
+
+// Forward kinematics of one frame: absolute camera-frame joints.
+Body joints_of(const FrameVars& vars, const FrameData& data, const Bones& bones);
+
+}  // namespace mocap::fit::detail
