@@ -79,7 +79,8 @@ void InputNoise::apply(const Condition& condition, recon::BodyXyc& body) {
 }
 
 RenderedSequence render(const TruthSequence& seq, const VirtualCamera& cam, const Image& image,
-                        const Condition& cond, std::uint64_t seed) {
+                        const Condition& cond, std::uint64_t seed,
+                        const recon::LayoutOffsets* input_layout) {
   RenderedSequence out;
   InputNoise noise(seed);
   const glm::quat rotation = camera_rotation(cam);
@@ -92,9 +93,11 @@ RenderedSequence render(const TruthSequence& seq, const VirtualCamera& cam, cons
                              root.z + cam.distance_m * std::cos(yaw));
     Body camera_frame;
     recon::BodyXyc xyc;
+    for (int j = 0; j < kBodyJoints; ++j) camera_frame[j] = rotation * (world[j] - position);
+    Body keypoints = camera_frame;
+    if (input_layout) recon::apply_layout_offsets_3d(*input_layout, keypoints, -1.0f);
     for (int j = 0; j < kBodyJoints; ++j) {
-      camera_frame[j] = rotation * (world[j] - position);
-      const glm::vec3& p = camera_frame[j];
+      const glm::vec3& p = keypoints[j];
       xyc[3 * j] = focal * p.x / p.z + 0.5f * static_cast<float>(image.width);
       xyc[3 * j + 1] = focal * p.y / p.z + 0.5f * static_cast<float>(image.height);
       xyc[3 * j + 2] = p.z > 0.1f ? 1.0f : 0.0f;

@@ -69,8 +69,13 @@ struct RenderedSequence {
   std::vector<Body> truth_camera;  // camera frame, metres
 };
 
+// With `input_layout`, the 2D input is rendered in that layout's keypoint definition: the truth's
+// canonical joints are moved to where the layout puts its keypoints
+// (recon::apply_layout_offsets_3d, direction -1, forward included) before projection; the truth
+// stays canonical.
 RenderedSequence render(const TruthSequence& sequence, const VirtualCamera& camera,
-                        const Image& image, const Condition& condition, std::uint64_t seed);
+                        const Image& image, const Condition& condition, std::uint64_t seed,
+                        const recon::LayoutOffsets* input_layout = nullptr);
 
 // Errors of one reconstruction against its truth: sums, so results of many sequences add up.
 struct Scores {

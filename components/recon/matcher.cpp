@@ -13,6 +13,7 @@ namespace mocap::recon {
 struct Matcher::Search {
   std::unique_ptr<posedb::SearchIndex> index;
   std::vector<posedb::Neighbor> neighbors;
+  float scale = 1.0f;  // the partial-body rescaling of the last search
 };
 
 Matcher::Matcher(const posedb::Database& db, const MatchOptions& options)
@@ -41,16 +42,19 @@ float partial_height(const float* row, const posedb::PoseVector& weights) {
   return hi - lo;
 }
 
-// The candidate's database pose retargeted to `person`, seen by its view and normalised as the
-// database's rows are; its squared distance to `query` over the weighted dimensions, or +inf when
-// the retargeted pose cannot be normalised.
+// The candidate's database pose retargeted to `person` (when given) and moved into `layout`'s
+// keypoint definition (when given), seen by its view and normalised as the database's rows are; its
+// squared distance to `query` over the weighted dimensions, or +inf when the retargeted pose cannot
+// be normalised.
 float person_distance(const posedb::Database& db, const Candidate& c,
-                      const motion::BodyProportions& person, const posedb::PoseVector& query,
+                      const std::optional<motion::BodyProportions>& person,
+                      const std::optional<LayoutOffsets>& layout, const posedb::PoseVector& query,
                       const posedb::PoseVector& weights) {
   const auto j = db.joints(c.frame);
   motion::Body15 body;
   for (int b = 0; b < kBodyJoints; ++b) body[b] = {j[3 * b], j[3 * b + 1], j[3 * b + 2]};
-  body = motion::retarget(body, person);
+  if (person) body = motion::retarget(body, *person);
+  if (layout) apply_layout_offsets_3d(*layout, body, -1.0f);
   const posedb::CameraPose camera =
       posedb::camera_pose(db.views()[c.view], db.build_info().views.root_height_m);
   std::array<glm::vec2, kBodyJoints> image;
@@ -98,6 +102,7 @@ void Matcher::search(const posedb::PoseVector& normalized, std::vector<Candidate
   const bool partial =
       present < kBodyJoints && db_.build_info().scaling == posedb::Scaling::bbox_height;
   const int passes = partial ? 1 + options_.rescale_passes : 1;
+  search_->scale = 1.0f;
   for (int pass = 0; pass < passes; ++pass) {
     search_->index->search(query.data(), weights.data(), options_.k, found);
     if (found.empty() || pass + 1 == passes) break;
@@ -105,17 +110,21 @@ void Matcher::search(const posedb::PoseVector& normalized, std::vector<Candidate
     const float own = partial_height(query.data(), weights);
     if (!(scale > 1e-4f) || !(own > 1e-4f)) break;
     for (int d = 0; d < posedb::kPoseDims; ++d) query[d] *= scale / own;
+    search_->scale *= scale / own;
   }
   const auto records = db_.projection_records();
   for (const auto& n : found) {
     out.push_back({n.index, records[n.index].frame, records[n.index].view, n.distance});
   }
-  if (person_) {
-    for (auto& c : out) c.distance = person_distance(db_, c, *person_, query, weights);
-    std::stable_sort(out.begin(), out.end(), [](const Candidate& a, const Candidate& b) {
-      return a.distance < b.distance;
-    });
-  }
+  if (person_ && !layout_) rescore(query, out);
+}
+
+void Matcher::rescore(const posedb::PoseVector& query, std::vector<Candidate>& out) const {
+  posedb::PoseVector weights;
+  for (int d = 0; d < posedb::kPoseDims; ++d) weights[d] = std::isfinite(query[d]) ? 1.0f : 0.0f;
+  for (auto& c : out) c.distance = person_distance(db_, c, person_, layout_, query, weights);
+  std::stable_sort(out.begin(), out.end(),
+                   [](const Candidate& a, const Candidate& b) { return a.distance < b.distance; });
 }
 
 bool Matcher::match(std::span<const float, kBodyJoints * 3> body, std::vector<Candidate>& out) {
@@ -124,7 +133,33 @@ bool Matcher::match(std::span<const float, kBodyJoints * 3> body, std::vector<Ca
     out.clear();
     return false;
   }
-  search(query, out);
+  if (!layout_) {
+    search(query, out);
+    return !out.empty();
+  }
+  // The search needs the canonical joints (the database's rows); the re-scoring compares the
+  // input as it is with the candidates moved into the layout.
+  std::array<float, kBodyJoints * 3> corrected;
+  std::copy(body.begin(), body.end(), corrected.begin());
+  apply_layout_offsets(*layout_, corrected);
+  posedb::PoseVector canonical;
+  if (!normalize_body(corrected, db_.build_info().scaling, options_.scaler, canonical)) {
+    out.clear();
+    return false;
+  }
+  // Both the corrected and the uncorrected input search: the 2D correction cannot express an
+  // offset towards the front or back of the body, so the right candidates may lie nearer the
+  // uncorrected keypoints. The union is re-scored.
+  search(canonical, out);
+  std::vector<Candidate> raw;
+  search(query, raw);
+  for (const Candidate& c : raw)
+    if (std::none_of(out.begin(), out.end(),
+                     [&](const Candidate& o) { return o.projection == c.projection; }))
+      out.push_back(c);
+  for (float& v : query) v *= search_->scale;  // a partial body: as the search rescaled it
+  rescore(query, out);
+  if (out.size() > static_cast<std::size_t>(options_.k)) out.resize(options_.k);
   return !out.empty();
 }
 

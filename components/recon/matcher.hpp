@@ -14,6 +14,7 @@
 #include "core/messages.hpp"
 #include "motion/canonical_body.hpp"
 #include "posedb/database.hpp"
+#include "recon/layout_offsets.hpp"
 
 namespace mocap::recon {
 
@@ -59,6 +60,17 @@ class Matcher {
   void set_person(std::optional<motion::BodyProportions> person) { person_ = std::move(person); }
   const std::optional<motion::BodyProportions>& person() const { return person_; }
 
+  // The layout the 2D input is in, when its keypoints are not the canonical joints
+  // (docs/keypoint-layouts.md). match() then searches with the input moved onto the canonical
+  // joints (apply_layout_offsets, 2D) and as it is, and re-scores the candidates of both (the
+  // best k are kept) the other way round: each
+  // candidate's canonical 3D joints (retargeted to the person when set) are moved into the
+  // layout's definition with the full 3D offsets (forward included,
+  // apply_layout_offsets_3d(-1)), projected with its view, normalised and compared with the
+  // input as it is. The input given to match() must then be the uncorrected keypoints.
+  void set_layout(std::optional<LayoutOffsets> layout) { layout_ = std::move(layout); }
+  const std::optional<LayoutOffsets>& layout() const { return layout_; }
+
   const MatchOptions& options() const { return options_; }
   const posedb::Database& database() const { return db_; }
 
@@ -66,7 +78,10 @@ class Matcher {
   const posedb::Database& db_;
   MatchOptions options_;
   std::optional<motion::BodyProportions> person_;
+  std::optional<LayoutOffsets> layout_;
   struct Search;
+  // Re-scores `out` against `query` (person_, layout_) and re-sorts it.
+  void rescore(const posedb::PoseVector& query, std::vector<Candidate>& out) const;
   std::unique_ptr<Search> search_;
 };
 

@@ -109,15 +109,21 @@ void smooth_sequence(std::vector<Pose3D>& poses, const SequenceOptions& options)
 std::vector<Pose3D> reconstruct_sequence(Matcher& matcher, const FrameBones& bones,
                                          std::span<const BodyXyc> input,
                                          const SequenceOptions& options) {
+  // The keypoints moved onto the canonical joints, for the matcher unless it takes the layout
+  // itself (Matcher::set_layout: it needs them as they are), and for the view refinement and
+  // the ray alignment in any case.
+  const LayoutOffsets* correction = options.layout_offsets ? &*options.layout_offsets
+                                    : matcher.layout()     ? &*matcher.layout()
+                                                           : nullptr;
   std::vector<BodyXyc> corrected;
-  if (options.layout_offsets) {
+  if (correction) {
     corrected.assign(input.begin(), input.end());
-    for (BodyXyc& frame : corrected) apply_layout_offsets(*options.layout_offsets, frame);
+    for (BodyXyc& frame : corrected) apply_layout_offsets(*correction, frame);
   }
-  const std::span<const BodyXyc> frames =
-      options.layout_offsets ? std::span<const BodyXyc>(corrected) : input;
+  const std::span<const BodyXyc> frames = correction ? std::span<const BodyXyc>(corrected) : input;
+  const std::span<const BodyXyc> to_match = matcher.layout() ? input : frames;
   std::vector<std::vector<Candidate>> candidates(frames.size());
-  for (std::size_t t = 0; t < frames.size(); ++t) matcher.match(frames[t], candidates[t]);
+  for (std::size_t t = 0; t < frames.size(); ++t) matcher.match(to_match[t], candidates[t]);
 
   std::vector<Pose3D> poses(frames.size());
   const posedb::Database& db = matcher.database();

@@ -40,7 +40,9 @@ struct SequenceOptions {
   // Search yaw and elevation around the matched view for the best fit (view_refinement.hpp).
   bool refine_view = false;
   // The input layout's keypoints moved onto the canonical joints before matching (the scaler's
-  // step, layout_offsets.hpp); none: the keypoints are matched as they are.
+  // step, layout_offsets.hpp); none: the keypoints are matched as they are. A matcher with a
+  // layout (Matcher::set_layout) gets the keypoints as they are whatever this says, and the view
+  // refinement and ray alignment then use them moved onto the canonical joints.
   std::optional<LayoutOffsets> layout_offsets;
 };
 

@@ -41,7 +41,8 @@ std::vector<eval::Scores> run_jobs(const std::vector<Config>& configs,
                                    const std::vector<eval::Condition>& conditions,
                                    const std::vector<eval::TruthSequence>& truth,
                                    const std::vector<std::unique_ptr<recon::FrameBones>>& bones,
-                                   int threads, ProgressBar& bar) {
+                                   const recon::LayoutOffsets* input_layout, int threads,
+                                   ProgressBar& bar) {
   std::vector<Job> jobs;
   for (std::size_t c = 0; c < configs.size(); ++c)
     for (std::size_t k = 0; k < cameras.size(); ++k)
@@ -60,10 +61,11 @@ std::vector<eval::Scores> run_jobs(const std::vector<Config>& configs,
           configs[j.config].person_bones
               ? std::optional(motion::measure_proportions(truth[j.sequence].world, false))
               : std::nullopt);
+      matchers[j.config]->set_layout(configs[j.config].candidate_layout);
       const std::uint64_t seed = 1000003ull * j.sequence + 1009ull * j.camera +
                                  j.condition;  // same input for every config
-      const auto rendered =
-          eval::render(truth[j.sequence], cameras[j.camera], {}, conditions[j.condition], seed);
+      const auto rendered = eval::render(truth[j.sequence], cameras[j.camera], {},
+                                         conditions[j.condition], seed, input_layout);
       recon::SequenceOptions options = configs[j.config].sequence;
       if (configs[j.config].align_to_ray) {
         const eval::Image image;
@@ -99,11 +101,29 @@ std::vector<std::string> split_list(const std::string& text) {
   return out;
 }
 
+// With an input layout: the configuration as it is, then with the layout's offsets applied to
+// the 2D input, then with them applied to the matcher's candidates (Matcher::set_layout).
+std::vector<Config> layout_variants(const Config& c,
+                                    const std::optional<recon::LayoutOffsets>& layout) {
+  if (!layout) return {c};
+  Config input = c, candidates = c;
+  input.name += " + 2D offsets";
+  input.description += "; the layout's offsets applied to the 2D input (" + layout->source + ")";
+  input.sequence.layout_offsets = layout;
+  candidates.name += " + candidate offsets";
+  candidates.description += "; candidates moved into the layout (" + layout->source +
+                            ", 3D, forward included) and re-scored";
+  candidates.candidate_layout = layout;
+  return {c, input, candidates};
+}
+
 // The configurations of every database (named "[label] ..." when there are several), the
-// paper's once, filtered by --configs, each doubled with --person-bones.
+// paper's once, filtered by --configs, each doubled with --person-bones (and tripled with an
+// input layout, layout_variants).
 std::vector<Config> select_configs(const std::vector<posedb::Database>& databases,
                                    const std::vector<std::string>& labels,
-                                   const posedb::Database& paper, const Args& args) {
+                                   const posedb::Database& paper, const Args& args,
+                                   const std::optional<recon::LayoutOffsets>& layout) {
   const auto prefixes = split_list(args.has("configs") ? args.get("configs") : "");
   auto wanted = [&](const std::string& name) {
     return prefixes.empty() || std::any_of(prefixes.begin(), prefixes.end(), [&](const auto& p) {
@@ -116,12 +136,14 @@ std::vector<Config> select_configs(const std::vector<posedb::Database>& database
       const bool is_paper = c.db == &paper;
       if (!wanted(c.name) || (is_paper && d > 0)) continue;
       if (databases.size() > 1 && !is_paper) c.name = "[" + labels[d] + "] " + c.name;
-      out.push_back(c);
-      if (args.has("person-bones") && !is_paper) {
-        c.name += " + person bones";
-        c.description += "; candidates re-scored on the person's proportions (given)";
-        c.person_bones = true;
-        out.push_back(c);
+      for (Config v : layout_variants(c, layout)) {
+        out.push_back(v);
+        if (args.has("person-bones") && !is_paper) {
+          v.name += " + person bones";
+          v.description += "; candidates re-scored on the person's proportions (given)";
+          v.person_bones = true;
+          out.push_back(v);
+        }
       }
     }
   }
@@ -169,6 +191,10 @@ int virtual_protocol(int argc, char** argv) {
       .option("json", "FILE", "where to write all numbers", "eval_virtual.json")
       .option("threads", "N", "worker threads", "2")
       .option("clips", "N", "use only the first N held-out clips (0 = all)", "0")
+      .option("input-layout", "FILE",
+              "render the 2D input in this layout's keypoint definition (calibration/layouts/"
+              "*.yaml;\nthe truth stays canonical) and run every configuration as is, \"+ 2D "
+              "offsets\" and\n\"+ candidate offsets\" (docs/keypoint-layouts.md)")
       .flag("quick", "2 yaws per camera family and 2 noise levels");
   int code = 0;
   if (!args.parse(argc, argv, code)) return code;
@@ -195,7 +221,9 @@ int virtual_protocol(int argc, char** argv) {
     truth.resize(n);
   const auto cameras = eval::default_cameras(args.has("quick"));
   const auto conditions = eval::default_conditions(args.has("quick"));
-  const auto configs = select_configs(databases, labels, paper, args);
+  std::optional<recon::LayoutOffsets> input_layout;
+  if (args.has("input-layout")) input_layout = recon::load_layout_offsets(args.get("input-layout"));
+  const auto configs = select_configs(databases, labels, paper, args, input_layout);
   std::vector<std::unique_ptr<recon::FrameBones>> bones;
   for (const auto& c : configs) bones.push_back(std::make_unique<recon::FrameBones>(*c.db));
 
@@ -205,8 +233,9 @@ int virtual_protocol(int argc, char** argv) {
             << " held-out clips (" << frames << " frames) x " << cameras.size() << " cameras x "
             << conditions.size() << " conditions\n";
   ProgressBar bar;
-  const auto summed = run_jobs(configs, cameras, conditions, truth, bones,
-                               static_cast<int>(std::clamp(args.integer("threads"), 1L, 64L)), bar);
+  const auto summed =
+      run_jobs(configs, cameras, conditions, truth, bones, input_layout ? &*input_layout : nullptr,
+               static_cast<int>(std::clamp(args.integer("threads"), 1L, 64L)), bar);
   bar.finish();
   auto at = [&](std::size_t c, std::size_t k, std::size_t n) -> const eval::Scores& {
     return summed[(c * cameras.size() + k) * conditions.size() + n];
@@ -219,6 +248,7 @@ int virtual_protocol(int argc, char** argv) {
               {"database", json::parse(full.options_json())},
               {"databases", databases_json(databases, labels)},
               {"paper_database", json::parse(paper.options_json())},
+              {"input_layout", input_layout ? input_layout->source : "canonical joints"},
               {"clips", truth.size()},
               {"frames", frames}};
   std::cout << "## Virtual protocol: " << truth.size() << " held-out clips, " << frames

@@ -2,6 +2,7 @@
 // What the `mocap eval` protocols share: the configurations compared side by side in one run
 // (../shared/docs/EVALUATION.md), the paper's database, and the JSON and table row of a score.
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -27,6 +28,9 @@ struct Config {
   // Re-score the matcher's candidates on the person's own proportions (Matcher::set_person); in
   // the virtual protocol they are given, measured from the truth clip.
   bool person_bones = false;
+  // The input's layout given to the matcher (Matcher::set_layout): candidates moved into the
+  // layout's keypoint definition when re-scored.
+  std::optional<recon::LayoutOffsets> candidate_layout = std::nullopt;
 };
 
 // The paper's configuration on `paper` (its yaw-only database), then per-frame nearest
