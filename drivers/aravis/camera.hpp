@@ -37,8 +37,8 @@ struct CameraSettings {
   std::string pixel_format;      // GenICam name (Mono8, BayerRG8, ...); empty: leave it
   int buffers = 0;               // stream buffers; 0: half a second of frames (4..64)
   // No buffer at all (whole or not) for this long, once streaming: the camera counts as lost, as
-  // when its heartbeat fails, but sooner (Aravis notices a GigE camera gone after about 14 s). At
-  // least 10 frame periods; the first frame may take 2 s more. 0: only the heartbeat.
+  // when its heartbeat fails, but sooner (Aravis' heartbeat notices a dead GigE camera after 6 s).
+  // At least 10 frame periods; the first frame may take 2 s more. 0: only the heartbeat.
   std::chrono::milliseconds loss_timeout{0};
   // Only for Aravis' in-process fake camera (enable_fake_interface): writes the pixels of every
   // frame, on Aravis' streaming thread, so tests can send their own images through the camera

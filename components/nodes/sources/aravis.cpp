@@ -34,7 +34,7 @@ class AravisSource : public Node {
     c.param<std::int64_t>("camera", 0, "camera id in the messages", {0, 1000});
     c.param<double>("loss_timeout_ms", 1000.0,
                     "no data for this long (at least 10 frame periods): the camera is lost and "
-                    "reopened; 0: only Aravis' heartbeat (about 14 s)",
+                    "reopened; 0: only Aravis' heartbeat (6 s on the fake GigE camera)",
                     {0, 3.6e6});
   }
 
@@ -118,7 +118,7 @@ class AravisSource : public Node {
     base_incomplete_ = incomplete_;
     base_skipped_ = skipped_;
     seen_drops_ = 0;
-    // Closing a camera that no longer answers waits for Aravis' timeouts (about 10 s on GigE):
+    // Closing a camera that no longer answers waits for Aravis' timeouts (5 to 10 s on GigE):
     // that happens on its own thread, so the reconnection attempts start at once.
     closing_.emplace_back([camera = std::move(camera_)]() mutable { camera.reset(); });
   }
