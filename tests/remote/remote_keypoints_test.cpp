@@ -288,6 +288,31 @@ TEST_F(RemoteKeypointsTest, KeypointsFromPythonArriveAsSentAndGarbageIsCounted) 
       << log;
 }
 
+// bind: false: the node connects to a sender that binds (send_keypoints.py --bind), which may
+// start first; PUSH keeps the frames until the node is there.
+TEST_F(RemoteKeypointsTest, TheNodeCanConnectToASenderThatBinds) {
+  const std::string endpoint = "tcp://127.0.0.1:" + std::to_string(free_tcp_port());
+  Python client(dir_, {"tools/remote/send_keypoints.py", kFolder, "--endpoint", endpoint, "--bind",
+                       "--limit", "20"});
+  std::this_thread::sleep_for(500ms);
+  const std::string graph = dir_.file("g.yaml");
+  write_file(graph,
+             "nodes:\n"
+             "  remote: { type: source.remote_keypoints, params: { endpoint: \"" +
+                 endpoint +
+                 "\", bind: false, timeout_ms: 30000 } }\n"
+                 "  collect: { type: test.collect, params: { path: \"" +
+                 dir_.file("got.txt") +
+                 "\" } }\n"
+                 "edges:\n"
+                 "  - [remote.out, collect.in]\n");
+  Mocap run(dir_, "run", {"run", graph});
+  ASSERT_EQ(run.wait(60s), 0) << run.err();
+  ASSERT_EQ(client.wait(30s), 0) << client.err();
+  EXPECT_EQ(read_lines(dir_.file("got.txt")).size(), 20u) << run.err();
+  EXPECT_NE(run.err().find("20 People2D received, 0 rejected"), std::string::npos) << run.err();
+}
+
 TEST_F(RemoteKeypointsTest, SilenceEndsTheStreamAfterTheTimeout) {
   const std::string graph = dir_.file("g.yaml");
   write_file(graph,
