@@ -194,14 +194,18 @@ struct VideoSource::Impl {
   }
 
   std::vector<int> ffmpeg_params(bool network) const {
+    // Built by push_back: GCC 12 warns (falsely) on insert() of an initializer list here.
     std::vector<int> params;
     if (network) {
-      params.insert(params.end(), {cv::CAP_PROP_OPEN_TIMEOUT_MSEC, options.timeout_ms,
-                                   cv::CAP_PROP_READ_TIMEOUT_MSEC, options.timeout_ms});
+      for (const int p : {static_cast<int>(cv::CAP_PROP_OPEN_TIMEOUT_MSEC), options.timeout_ms,
+                          static_cast<int>(cv::CAP_PROP_READ_TIMEOUT_MSEC), options.timeout_ms})
+        params.push_back(p);
     }
 #if CV_VERSION_MAJOR > 4 || (CV_VERSION_MAJOR == 4 && CV_VERSION_MINOR >= 7)
-    if (options.decoder_threads > 0)
-      params.insert(params.end(), {cv::CAP_PROP_N_THREADS, options.decoder_threads});
+    if (options.decoder_threads > 0) {
+      params.push_back(cv::CAP_PROP_N_THREADS);
+      params.push_back(options.decoder_threads);
+    }
 #endif
     return params;
   }
