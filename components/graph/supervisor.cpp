@@ -61,12 +61,15 @@ struct Supervisor::Impl {
 
     posix_spawnattr_t attr;
     posix_spawnattr_init(&attr);
-    sigset_t none, defaults;
-    sigemptyset(&none);
-    sigemptyset(&defaults);
-    sigaddset(&defaults, SIGINT);
-    sigaddset(&defaults, SIGTERM);
-    posix_spawnattr_setsigmask(&attr, &none);
+    // The group starts with the stop signals blocked and at their default action: a SIGTERM
+    // that arrives while it is still loading its libraries stays pending until its signal
+    // watcher takes it, instead of killing it before it can drain.
+    sigset_t stop_signals, defaults;
+    sigemptyset(&stop_signals);
+    sigaddset(&stop_signals, SIGINT);
+    sigaddset(&stop_signals, SIGTERM);
+    defaults = stop_signals;
+    posix_spawnattr_setsigmask(&attr, &stop_signals);
     posix_spawnattr_setsigdefault(&attr, &defaults);
     posix_spawnattr_setpgroup(&attr, 0);
     posix_spawnattr_setflags(

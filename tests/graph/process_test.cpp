@@ -90,7 +90,9 @@ TEST_P(SplitGraph, SigtermToTheSupervisorDrainsEveryGroupAndExitsZero) {
   const std::string graph = dir.file("g.yaml");
   testing::write_file(graph, split_graph(dir, GetParam(), 0, 2));
   Mocap run(dir, "run", {"run", graph});
-  ASSERT_TRUE(run.wait_for_log("started group 'solve'", 20s)) << run.err();
+  // Both groups up (their libraries loaded, their signal watchers on), then messages flow.
+  ASSERT_TRUE(run.wait_for_log(R"(\[capture\]: running)", 30s)) << run.err();
+  ASSERT_TRUE(run.wait_for_log(R"(\[solve\]: running)", 30s)) << run.err();
   std::this_thread::sleep_for(1s);
   kill(run.pid(), SIGTERM);
   ASSERT_EQ(run.wait(60s), 0) << run.err();

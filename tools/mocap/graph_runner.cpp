@@ -45,6 +45,7 @@ graph::RunResult run_graph_here(const graph::ResolvedGraph& graph, graph::RunOpt
     std::cerr << label << ": stopping: draining the graph (signal again to exit at once)\n";
     relay.request();
   });
+  const bool one_group = !options.process.empty();
   graph::Runtime runtime(graph, std::move(options));
   relay.attach(&runtime);
   std::mutex done_mutex;
@@ -57,6 +58,9 @@ graph::RunResult run_graph_here(const graph::ResolvedGraph& graph, graph::RunOpt
       while (!done_changed.wait_for(lock, every, [&] { return done; })) progress(runtime.stats());
     });
   }
+  // A supervised group says when it is up, so its supervisor's log (and tests) can tell a group
+  // that is still starting from one that runs.
+  if (one_group) std::cerr << label << ": running\n";
   graph::RunResult result = runtime.run();
   if (reporter.joinable()) {
     {
