@@ -97,15 +97,14 @@ std::vector<Body> truth_in_camera(const std::vector<he::Pose3>& positions, const
 
 std::vector<HumanEvaSequence> humaneva_validation_sequences(const he::Dataset& dataset,
                                                             const HumanEvaCameras& cameras,
-                                                            double fps) {
+                                                            double fps, he::Split split) {
   std::vector<HumanEvaSequence> out;
   for (const std::string_view subject : kHumanEvaSubjects) {
     const auto subject_cameras = cameras.find(std::string(subject));
     if (subject_cameras == cameras.end())
       throw InputError(std::string(he::kCamerasFile), "no cameras for " + std::string(subject));
     for (const HumanEvaAction& action : kHumanEvaActions) {
-      for (const he::Chunk* chunk :
-           dataset.select(he::Split::validate, subject, action.data_name)) {
+      for (const he::Chunk* chunk : dataset.select(split, subject, action.data_name)) {
         for (int c = 0; c < he::kCameras; ++c) {
           if (chunk->positions_2d[c].size() != chunk->frames())
             throw InputError(std::string(he::kPositions2dFile),

@@ -68,9 +68,10 @@ struct HumanEvaSequence {
 
 // Every Validate chunk of the evaluated subjects and actions through every camera, resampled
 // from 60 Hz to `fps`. Throws InputError when a subject has no cameras.
-std::vector<HumanEvaSequence> humaneva_validation_sequences(const io::humaneva::Dataset& dataset,
-                                                            const HumanEvaCameras& cameras,
-                                                            double fps);
+// `split` Train gives the same for the Train chunks (for choosing settings on Train only).
+std::vector<HumanEvaSequence> humaneva_validation_sequences(
+    const io::humaneva::Dataset& dataset, const HumanEvaCameras& cameras, double fps,
+    io::humaneva::Split split = io::humaneva::Split::validate);
 
 // Adds the condition's noise to the input, reconstructs it and scores it against the truth.
 // With `map_back` and `mapped`, the reconstruction is also scored after moving its canonical

@@ -21,6 +21,7 @@
 #include "eval/humaneva_protocol.hpp"
 #include "eval_configs.hpp"
 #include "eval_report.hpp"
+#include "motion/canonical_body.hpp"
 #include "posedb/parallel_chunks.hpp"
 #include "progress_bar.hpp"
 #include "recon/layout_offsets.hpp"
@@ -110,11 +111,40 @@ struct Job {
   std::size_t family, config, condition, sequence;
 };
 
+// Each subject's proportions measured on the Train split (Walk, Jog, Box), its joints first
+// moved onto the canonical joints with the HumanEva-15 offsets (3D, forward included): the
+// shoulders and hips are joint centres in both, the neck, head and root are not.
+std::map<std::string, motion::BodyProportions> train_proportions(
+    const he::Dataset& data, const recon::LayoutOffsets& offsets) {
+  std::map<std::string, motion::BodyProportions> out;
+  for (const std::string_view subject : eval::kHumanEvaSubjects) {
+    std::vector<motion::Body15> frames;
+    for (const auto& action : eval::kHumanEvaActions)
+      for (const he::Chunk* chunk : data.select(he::Split::train, subject, action.data_name))
+        for (const he::Pose3& pose : chunk->positions_3d) {
+          motion::Body15 body = he::to_body15(pose);
+          recon::apply_layout_offsets_3d(offsets, body, 1.0f);
+          frames.push_back(body);
+        }
+    if (frames.empty())
+      throw InputError(std::string(he::kPositions3dFile),
+                       "no Train frames of " + std::string(subject) + " to measure");
+    out[std::string(subject)] = motion::measure_proportions(frames, true);
+  }
+  return out;
+}
+
+// Where a variant applies the layout offsets: not at all, to the 2D input before matching
+// (SequenceOptions::layout_offsets) or to the matcher's candidates (Matcher::set_layout).
+enum class OffsetsOn { none, input, candidates };
+
 // A configuration as one run compares it: with or without the layout offsets of the input
-// (HumanEva-15 -> canonical joints before matching).
+// (HumanEva-15 -> canonical joints), on the database's body or the person's Train proportions.
 struct Variant {
   Config config;
   const recon::LayoutOffsets* offsets = nullptr;
+  OffsetsOn on = OffsetsOn::none;
+  const std::map<std::string, motion::BodyProportions>* person = nullptr;  // per subject
 };
 
 // One row of the tables: a name and its scores per (condition, sequence), in job order.
@@ -150,10 +180,12 @@ std::vector<std::vector<Row>> run_jobs(const std::vector<std::vector<Variant>>& 
         const Variant& variant = variants[job.family][job.config];
         const Config& config = variant.config;
         recon::Matcher matcher(*config.db, config.match);
+        if (variant.person) matcher.set_person(variant.person->at(sequences[job.sequence].subject));
         const std::uint64_t seed = 1000003ull * job.sequence + job.condition;  // same for all
         recon::SequenceOptions options = config.sequence;
         if (config.align_to_ray) options.camera = sequences[job.sequence].intrinsics;
-        if (variant.offsets) options.layout_offsets = *variant.offsets;
+        if (variant.on == OffsetsOn::input) options.layout_offsets = *variant.offsets;
+        if (variant.on == OffsetsOn::candidates) matcher.set_layout(*variant.offsets);
         results[i] = eval::evaluate_sequence(matcher, *bones.at(config.db), sequences[job.sequence],
                                              conditions[job.condition], options, seed,
                                              variant.offsets, &mapped[i]);
@@ -168,15 +200,24 @@ std::vector<std::vector<Row>> run_jobs(const std::vector<std::vector<Variant>>& 
     for (const Variant& v : variants[f]) {
       const std::size_t n = conditions.size() * sequences.size();
       Row row{v.config.name, v.config.description, {}};
+      if (v.person) {
+        row.name += " + Train proportions";
+        row.description +=
+            "; candidates re-scored on the subject's proportions measured on HumanEva Train";
+      }
       row.scores.assign(results.begin() + i, results.begin() + i + n);
       if (v.offsets) {
-        row.name += " + offsets";
-        row.description +=
-            "; input moved onto the canonical joints (" + v.offsets->source + "), output canonical";
-        Row back{v.config.name + " + offsets, mapped back",
-                 v.config.description + "; input moved onto the canonical joints (" +
-                     v.offsets->source +
-                     "), output mapped back into HumanEva-15's thorax/pelvis/headDistal",
+        const std::string name = row.name, description = row.description;
+        const std::string how =
+            v.on == OffsetsOn::input
+                ? "input moved onto the canonical joints (" + v.offsets->source + ")"
+                : "candidates moved into HumanEva-15 (" + v.offsets->source +
+                      ", 3D, forward included) and re-scored";
+        row.name += v.on == OffsetsOn::input ? " + 2D offsets" : " + candidate offsets";
+        row.description += "; " + how + ", output canonical";
+        Row back{row.name + ", mapped back",
+                 description + "; " + how +
+                     ", output mapped back into HumanEva-15's thorax/pelvis/headDistal",
                  {}};
         back.scores.assign(mapped.begin() + i, mapped.begin() + i + n);
         rows[f].push_back(std::move(row));
@@ -194,8 +235,8 @@ std::string cell_name(std::string_view action, std::string_view subject) {
   return std::string(action) + " " + std::string(subject);
 }
 
-void print_cells_header(const std::string& family) {
-  std::cout << "\n## HumanEva-I Validate, " << family
+void print_cells_header(const std::string& split, const std::string& family) {
+  std::cout << "\n## HumanEva-I " << split << ", " << family
             << " database: PA-MPJPE mm per action and subject\n\n| configuration | condition |";
   for (const auto& a : eval::kHumanEvaActions)
     for (const auto s : eval::kHumanEvaSubjects) std::cout << " " << cell_name(a.label, s) << " |";
@@ -242,10 +283,10 @@ constexpr const char* kJointNote =
 // Tables per family and the JSON of every number.
 json report(const std::vector<DatabaseFamily>& families, const std::vector<std::vector<Row>>& rows,
             const std::vector<eval::Condition>& conditions,
-            const std::vector<eval::HumanEvaSequence>& sequences) {
+            const std::vector<eval::HumanEvaSequence>& sequences, const std::string& split) {
   json out = json::object();
   for (std::size_t f = 0; f < families.size(); ++f) {
-    print_cells_header(families[f].name);
+    print_cells_header(split, families[f].name);
     struct Total {
       std::string config, condition;
       eval::Scores scores;
@@ -265,7 +306,7 @@ json report(const std::vector<DatabaseFamily>& families, const std::vector<std::
       per_config[row.name] = {{"description", row.description}, {"per_condition", per_condition}};
     }
     std::cout
-        << "\n## HumanEva-I Validate, " << families[f].name
+        << "\n## HumanEva-I " << split << ", " << families[f].name
         << " database: all frames\n\n| configuration | condition | MPJPE mm | PA-MPJPE mm "
            "| accel err mm/f² | jitter mm/f² | coverage |\n|---|---|---:|---:|---:|---:|---:|\n";
     for (const Total& t : totals) print_row(t.config, t.condition, t.scores);
@@ -310,12 +351,22 @@ int humaneva_eval_command(int argc, char** argv) {
       .option("configs", "NAMES",
               "comma-separated configurations to run (e.g. 'per-frame NN,full: path + SG + ray + "
               "view'; all when absent)")
-      .option("layout-offsets", "off|auto|FILE|compare",
-              "move the HumanEva-15 input onto the canonical joints before matching with the CMU "
-              "database (auto: calibration/layouts/humaneva15.yaml); compare: every "
-              "configuration with and without. Rows with offsets are scored twice: the canonical "
-              "output, and that output mapped back into HumanEva's own joints",
+      .option("layout-offsets", "off|auto|FILE|compare|compare:FILE",
+              "correct for the HumanEva-15 keypoints not being the canonical joints when "
+              "matching with the CMU database (auto: calibration/layouts/humaneva15.yaml): "
+              "the matcher's candidates are moved into HumanEva-15 and re-scored (\"+ candidate "
+              "offsets\"); compare: every configuration without, with the 2D input moved onto "
+              "the canonical joints (\"+ 2D offsets\") and with candidate offsets. Rows with "
+              "offsets are scored twice: the canonical output, and that output mapped back into "
+              "HumanEva's own joints",
               "off")
+      .flag("train-proportions",
+            "run every CMU-database row once more with the candidates re-scored on each "
+            "subject's\nproportions measured on HumanEva Train (\"+ Train proportions\")")
+      .option("evaluate-on", "validate|train",
+              "the split evaluated: train only to choose settings (the HumanEva databases are "
+              "built from it)",
+              "validate")
       .flag("no-humaneva-db", "skip the databases built from HumanEva Train")
       .flag("quick", "2 noise levels instead of 5");
   int code = 0;
@@ -338,15 +389,31 @@ int humaneva_eval_command(int argc, char** argv) {
   };
   const bool with_paper = selected("paper");
   const std::string offsets_setting = args.get("layout-offsets");
-  const bool compare = offsets_setting == "compare";
+  const bool compare = offsets_setting.starts_with("compare");
+  const std::string offsets_file = offsets_setting.starts_with("compare:")
+                                       ? offsets_setting.substr(8)
+                                   : compare ? "auto"
+                                             : offsets_setting;
   const std::optional<recon::LayoutOffsets> offsets =
-      offsets_setting == "off"
-          ? std::nullopt
-          : recon::resolve_layout_offsets(compare ? "auto" : offsets_setting, LayoutId::humaneva15);
+      offsets_setting == "off" ? std::nullopt
+                               : recon::resolve_layout_offsets(offsets_file, LayoutId::humaneva15);
   if (offsets_setting != "off" && !offsets)
     throw InputError("--layout-offsets", "no " +
                                              recon::layout_offsets_file_name(LayoutId::humaneva15) +
                                              " in calibration/layouts (mocap calibrate layout)");
+
+  std::optional<std::map<std::string, motion::BodyProportions>> proportions;
+  if (args.has("train-proportions")) {
+    const auto definition =
+        offsets ? offsets : recon::resolve_layout_offsets("auto", LayoutId::humaneva15);
+    if (!definition)
+      throw InputError("--train-proportions",
+                       "needs calibration/layouts/humaneva15.yaml (the canonical neck, head and "
+                       "root in HumanEva's joints)");
+    proportions = train_proportions(data, *definition);
+    for (const auto& [subject, p] : *proportions)
+      std::cerr << subject << " Train proportions: " << motion::describe(p) << "\n";
+  }
 
   std::vector<DatabaseFamily> families;
   posedb::Database cmu = posedb::Database::open(args.get("db"));
@@ -371,14 +438,25 @@ int humaneva_eval_command(int argc, char** argv) {
          make_configs(family.full, family.paper ? *family.paper : family.full, fps)) {
       if (!selected(c.name)) continue;
       const bool cmu_family = f == 0;
-      if (!offsets || compare || !cmu_family) list.push_back({c, nullptr});
-      if (offsets && cmu_family) list.push_back({c, &*offsets});
+      std::vector<const std::map<std::string, motion::BodyProportions>*> people = {nullptr};
+      if (proportions && cmu_family) people.push_back(&*proportions);
+      for (const auto* person : people) {
+        if (!offsets || compare || !cmu_family)
+          list.push_back({c, nullptr, OffsetsOn::none, person});
+        if (offsets && cmu_family && compare)
+          list.push_back({c, &*offsets, OffsetsOn::input, person});
+        if (offsets && cmu_family) list.push_back({c, &*offsets, OffsetsOn::candidates, person});
+      }
     }
     if (list.empty()) throw InputError("--configs", "no configuration of that name");
     variants.push_back(std::move(list));
   }
   const auto conditions = eval::default_conditions(args.has("quick"));
-  const auto sequences = eval::humaneva_validation_sequences(data, cameras, fps);
+  const bool on_train = args.get("evaluate-on") == "train";
+  if (!on_train && args.get("evaluate-on") != "validate")
+    throw InputError("--evaluate-on", "validate or train");
+  const auto sequences = eval::humaneva_validation_sequences(
+      data, cameras, fps, on_train ? he::Split::train : he::Split::validate);
   std::cerr << "evaluating " << variants.front().size() << " configurations x " << families.size()
             << " databases on " << sequences.size() << " sequences (chunk x camera) x "
             << conditions.size() << " conditions\n";
@@ -394,8 +472,12 @@ int humaneva_eval_command(int argc, char** argv) {
               {"joints", kJointNote},
               {"joint_correspondence", eval::humaneva_joint_correspondence()},
               {"validation", sequences_json(sequences)}};
+  out["evaluated_split"] = on_train ? "Train" : "Validate";
   if (offsets) out["layout_offsets"] = offsets->source;
-  out["results"] = report(families, rows, conditions, sequences);
+  if (proportions)
+    for (const auto& [subject, p] : *proportions)
+      out["train_proportions"][subject] = motion::describe(p);
+  out["results"] = report(families, rows, conditions, sequences, on_train ? "Train" : "Validate");
   std::cout << "\nJoints: " << kJointNote << ":\n";
   for (const auto& line : eval::humaneva_joint_correspondence()) std::cout << "- " << line << "\n";
   std::cout << "\nRate: " << kRateNote << ".\n\nConfigurations:\n";
