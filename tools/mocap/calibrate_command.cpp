@@ -141,6 +141,10 @@ int layout_command(int argc, char** argv) {
       .option("humaneva", "DIR", "HumanEva-I in the VideoPose3D format")
       .option("layout", "NAME", "BODY_25B, COCO-17, BODY_25, COCO-18 (Pose2Sim) or HumanEva-15",
               "BODY_25B")
+      .option("leave", "JOINTS",
+              "comma-separated Body15 joints left uncorrected (basis none), e.g. root for "
+              "HumanEva-15\n(docs/keypoint-layouts.md: its hips are not joint centres, so "
+              "its root offset hurts)")
       .option("out", "FILE", "where to write the offsets (nothing written when absent)");
   int code = 0;
   if (!args.parse(argc, argv, code)) return code;
@@ -178,8 +182,20 @@ int layout_command(int argc, char** argv) {
     if (lay->id == LayoutId::humaneva15 && t.name != "Train") continue;
     fit_frames.insert(fit_frames.end(), t.frames.begin(), t.frames.end());
   }
-  const eval::LayoutFit fit =
-      eval::fit_layout_offsets(lay->id, fit_frames, eval::default_bases(lay->id));
+  auto bases = eval::default_bases(lay->id);
+  std::string left_alone;
+  if (args.has("leave")) {
+    std::stringstream list(args.get("leave"));
+    for (std::string name; std::getline(list, name, ',');) {
+      const auto* found = std::find(kJointNames.begin(), kJointNames.end(), name);
+      if (found == kJointNames.end())
+        throw InputError("--leave", "'" + name + "' is not a Body15 joint name");
+      bases[static_cast<std::size_t>(found - kJointNames.begin())] = recon::OffsetBasis::none;
+      left_alone += (left_alone.empty() ? "" : ", ") + name;
+    }
+    source += "; left uncorrected (--leave): " + left_alone;
+  }
+  const eval::LayoutFit fit = eval::fit_layout_offsets(lay->id, fit_frames, bases);
   std::ostringstream report;
   report << "## " << lay->name << ": fitted offsets (3D, " << fit_frames.size()
          << " frames; offset = reference - keypoint in the body frame before correction)\n\n"

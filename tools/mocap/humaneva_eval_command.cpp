@@ -388,6 +388,11 @@ int humaneva_eval_command(int argc, char** argv) {
     return wanted.empty() || std::find(wanted.begin(), wanted.end(), name) != wanted.end();
   };
   const bool with_paper = selected("paper");
+  const bool on_train = args.get("evaluate-on") == "train";
+  if (!on_train && args.get("evaluate-on") != "validate")
+    throw InputError("--evaluate-on", "validate or train");
+  if (on_train && !args.has("no-humaneva-db"))
+    throw InputError("--evaluate-on", "train needs --no-humaneva-db (those databases are Train)");
   const std::string offsets_setting = args.get("layout-offsets");
   const bool compare = offsets_setting.starts_with("compare");
   const std::string offsets_file = offsets_setting.starts_with("compare:")
@@ -452,9 +457,6 @@ int humaneva_eval_command(int argc, char** argv) {
     variants.push_back(std::move(list));
   }
   const auto conditions = eval::default_conditions(args.has("quick"));
-  const bool on_train = args.get("evaluate-on") == "train";
-  if (!on_train && args.get("evaluate-on") != "validate")
-    throw InputError("--evaluate-on", "validate or train");
   const auto sequences = eval::humaneva_validation_sequences(
       data, cameras, fps, on_train ? he::Split::train : he::Split::validate);
   std::cerr << "evaluating " << variants.front().size() << " configurations x " << families.size()
