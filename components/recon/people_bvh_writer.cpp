@@ -13,7 +13,8 @@ std::string PeopleBvhSummary::describe() const {
   return std::to_string(files) + " files, " + std::to_string(frames) + " frames (" +
          std::to_string(held_over_gaps) + " held over gaps), " + std::to_string(skeleton_mismatch) +
          " skeleton_mismatch, " + std::to_string(no_provenance) + " without provenance, " +
-         std::to_string(no_skeleton) + " without skeleton";
+         std::to_string(no_skeleton) + " without skeleton, " + std::to_string(short_tracks) +
+         " short tracks without a file";
 }
 
 PeopleBvhWriter::PeopleBvhWriter(const posedb::Database& db, PeopleBvhOptions options)
@@ -23,6 +24,8 @@ PeopleBvhWriter::PeopleBvhWriter(const posedb::Database& db, PeopleBvhOptions op
     throw std::invalid_argument("PeopleBvhWriter: fps must be positive");
   if (options_.max_open_files < 1)
     throw std::invalid_argument("PeopleBvhWriter: max_open_files must be at least 1");
+  if (options_.min_frames < 1)
+    throw std::invalid_argument("PeopleBvhWriter: min_frames must be at least 1");
   std::error_code ec;
   std::filesystem::create_directories(options_.dir, ec);
   if (ec) throw InputError(options_.dir, "cannot create the output folder: " + ec.message());
@@ -57,16 +60,34 @@ void PeopleBvhWriter::start(const Person3D& person, std::int64_t frame) {
     ++summary_.no_skeleton;  // position-only motion; a later pose may come from a real clip
     return;
   }
-  keep_open_files_bounded(person.id);
   BvhFrameMaker maker(skeleton, db_.clips()[db_.frames()[pose->frame].clip].source);
   if (options_.smooth_rotations) maker.enable_smoothing(options_.smoothing);
   std::vector<float> values;
   maker.channels(db_, *pose, seconds(frame), values);
-  motion::BvhStreamWriter file(path_for(person.id), skeleton, 1.0 / options_.fps);
-  file.append(values);
-  tracks_.emplace(person.id, Track{std::move(file), std::move(maker), std::move(values), frame});
+  Track& track =
+      tracks_
+          .emplace(person.id,
+                   Track{std::nullopt, skeleton, std::move(maker), std::move(values), {}, frame})
+          .first->second;
+  emit(person.id, track);
+}
+
+// Writes track.values as the track's next frame: into its file, or held until it has min_frames.
+void PeopleBvhWriter::emit(int id, Track& track) {
+  if (track.file) {
+    if (track.file->is_suspended()) keep_open_files_bounded(id);
+    track.file->append(track.values);
+    ++summary_.frames;
+    return;
+  }
+  track.pending.push_back(track.values);
+  if (static_cast<int>(track.pending.size()) < options_.min_frames) return;
+  keep_open_files_bounded(id);
+  track.file.emplace(path_for(id), track.skeleton, 1.0 / options_.fps);
   ++summary_.files;
-  ++summary_.frames;
+  for (const std::vector<float>& values : track.pending) track.file->append(values);
+  summary_.frames += static_cast<std::int64_t>(track.pending.size());
+  track.pending = {};
 }
 
 double PeopleBvhWriter::seconds(std::int64_t frame) const {
@@ -75,11 +96,9 @@ double PeopleBvhWriter::seconds(std::int64_t frame) const {
 
 void PeopleBvhWriter::append(Track& track, const Person3D& person, std::int64_t frame) {
   if (frame == track.last_frame) return;  // the same id twice in one frame: the first one counts
-  if (track.file.is_suspended()) keep_open_files_bounded(person.id);
   for (std::int64_t missed = track.last_frame + 1; missed < frame; ++missed) {
-    track.file.append(track.values);
+    emit(person.id, track);
     ++summary_.held_over_gaps;
-    ++summary_.frames;
   }
   // When this pose cannot be written on the file's skeleton, the previous one is held.
   if (const std::optional<DatabasePose> pose = database_pose_of(db_, person); !pose) {
@@ -89,8 +108,7 @@ void PeopleBvhWriter::append(Track& track, const Person3D& person, std::int64_t 
   } else {
     track.maker.channels(db_, *pose, seconds(frame), track.values);
   }
-  track.file.append(track.values);
-  ++summary_.frames;
+  emit(person.id, track);
   track.last_frame = frame;
 }
 
@@ -99,18 +117,23 @@ void PeopleBvhWriter::keep_open_files_bounded(int arriving_id) {
   int open = 0;
   Track* oldest = nullptr;
   for (auto& [id, track] : tracks_) {
-    if (!track.file.is_open() || id == arriving_id) continue;
+    if (!track.file || !track.file->is_open() || id == arriving_id) continue;
     ++open;
     if (!oldest || track.last_frame < oldest->last_frame) oldest = &track;
   }
-  if (open >= options_.max_open_files && oldest) oldest->file.suspend();
+  if (open >= options_.max_open_files && oldest) oldest->file->suspend();
 }
 
 void PeopleBvhWriter::close() {
   std::exception_ptr first_error;
   for (auto& [id, track] : tracks_) {
+    if (!track.file) {
+      if (!track.pending.empty()) ++summary_.short_tracks;
+      track.pending = {};
+      continue;
+    }
     try {
-      track.file.close();
+      track.file->close();
     } catch (...) {
       if (!first_error) first_error = std::current_exception();
     }

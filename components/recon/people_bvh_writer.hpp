@@ -7,9 +7,14 @@
 // missing for some input frames and comes back, their last pose is repeated for the frames
 // missed, so the file stays in step with the video and the JSON lines; a person who never comes
 // back gets no frames after their last appearance (nothing is padded at the end).
+//
+// A tracker also makes short-lived ids (a false detection, a person seen for a moment): a file is
+// only started once its person has `min_frames` frames, which are held in memory until then; an
+// id that never gets there leaves no file and is counted as a short track.
 
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -25,6 +30,7 @@ struct PeopleBvhOptions {
   std::string prefix = "person_";  // file name before the id
   double fps = 30.0;               // the input frame rate, written as the frame time
   int max_open_files = 64;         // more people than this: the longest-unseen file is suspended
+  int min_frames = 1;              // frames (held gaps included) before a person's file is made
   // The database's rotations change abruptly where the chosen motion jumps between clips: the
   // 1-Euro filter (on the rotation group, per joint) smooths them, as the paper smooths its motion.
   bool smooth_rotations = true;
@@ -38,6 +44,7 @@ struct PeopleBvhSummary {
   std::int64_t skeleton_mismatch = 0;  // pose from a clip of another skeleton: previous one held
   std::int64_t no_provenance = 0;      // pose naming no database frame: previous one held or none
   std::int64_t no_skeleton = 0;        // first pose's clip has no skeleton: file not started yet
+  std::int64_t short_tracks = 0;       // ids that ended with fewer than min_frames: no file
 
   std::string describe() const;  // one line for logs
 };
@@ -58,15 +65,18 @@ class PeopleBvhWriter {
 
  private:
   struct Track {
-    motion::BvhStreamWriter file;
+    std::optional<motion::BvhStreamWriter> file;  // made once the track has min_frames
+    motion::Skeleton skeleton;
     BvhFrameMaker maker;
-    std::vector<float> values;  // the last pose written
+    std::vector<float> values;                // the last pose written
+    std::vector<std::vector<float>> pending;  // frames before the file exists
     std::int64_t last_frame = 0;
   };
 
   double seconds(std::int64_t frame) const;
   void start(const Person3D& person, std::int64_t frame);
   void append(Track& track, const Person3D& person, std::int64_t frame);
+  void emit(int id, Track& track);  // one frame: track.values
   void keep_open_files_bounded(int arriving_id);
 
   const posedb::Database& db_;

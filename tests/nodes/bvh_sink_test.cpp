@@ -24,13 +24,13 @@ using testing::run_graph;
 using testing::stats_of;
 
 std::string bvh_graph(const std::string& db, const std::string& dir, const std::string& script,
-                      const std::string& extra_source_params = "") {
+                      const std::string& extra_source_params = "", int min_frames = 1) {
   return R"(
 nodes:
   src: { type: unit.people_script, params: { db: )" +
          db + ", script: \"" + script + "\"" + extra_source_params + R"( } }
   bvh: { type: sink.bvh, params: { db: )" +
-         db + ", dir: " + dir + R"(, fps: 24 } }
+         db + ", dir: " + dir + ", min_frames: " + std::to_string(min_frames) + R"(, fps: 24 } }
 edges:
   - [src.people3d, bvh.in]
 )";
@@ -70,6 +70,19 @@ TEST(BvhSink, OneFilePerPersonOnTheClipSkeletonWithGapsHeld) {
   EXPECT_EQ(eight.skeleton.joints[0].name, "joint_Root");  // Bandai
   EXPECT_EQ(row(eight, 1), row(eight, 0));  // a CMU pose cannot be written on it: held
   EXPECT_NE(row(eight, 3), row(eight, 0));  // Bandai again
+}
+
+// A tracker's short-lived ids leave no file: person 8 (4 frames) stays under min_frames 5, while
+// person 5 reaches it only through its held gap frames and is written whole from its first frame.
+TEST(BvhSink, ShortTracksLeaveNoFile) {
+  MOCAP_REQUIRE_SMALL_DATABASE(db);
+  test::TempDir dir;
+  const std::string out = (dir.path() / "bvh").string();
+  const graph::RunResult result = run_graph(bvh_graph(db, out, kScript, "", 5));
+  ASSERT_TRUE(result.ok) << result.error;
+  EXPECT_EQ(motion::read_bvh(out + "/person_3.bvh").frame_count, 6);
+  EXPECT_EQ(motion::read_bvh(out + "/person_5.bvh").frame_count, 6);
+  EXPECT_FALSE(std::filesystem::exists(out + "/person_8.bvh"));
 }
 
 TEST(BvhSink, MissingDatabaseFailsTheGraphNamingTheFile) {

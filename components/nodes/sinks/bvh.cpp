@@ -26,6 +26,9 @@ class BvhSink : public Node {
     c.param<double>("beta", 0.4, "1-Euro cutoff slope for the rotations", {0.0, 100.0});
     c.param<double>("min_cutoff", 1.0, "1-Euro cutoff at rest (Hz) for the rotations",
                     {0.001, 1000.0});
+    c.param<int>("min_frames", 12,
+                 "frames a person must have before their file is made (shorter ids: no file)",
+                 {1, 1000000});
     c.param<double>("fps", 30.0, "input frame rate, written as the BVH frame time",
                     {0.001, 10000.0});
   }
@@ -36,6 +39,7 @@ class BvhSink : public Node {
     options.dir = ctx.param<std::string>("dir");
     options.prefix = ctx.param<std::string>("prefix");
     options.fps = ctx.param<double>("fps");
+    options.min_frames = ctx.param<int>("min_frames");
     options.smooth_rotations = ctx.param<bool>("smooth");
     options.smoothing.beta = ctx.param<double>("beta");
     options.smoothing.min_cutoff = ctx.param<double>("min_cutoff");
