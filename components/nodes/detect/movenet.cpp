@@ -25,6 +25,7 @@ class MovenetNode : public Node {
     c.param<double>("min_person_score", 0.25, "people scoring below are dropped", {0.0, 1.0});
     c.param<double>("min_keypoint_score", 0.3, "keypoints scoring below are missing", {0.0, 1.0});
     c.param<int>("threads", 0, "cv::dnn threads, process-wide (0: OpenCV's default)", {0, 64});
+    c.param<bool>("warm_up", true, "run the network once on a blank image when the node opens");
     c.param<std::string>("model", "", "model.json (empty: the cache tools/setup.sh fills)");
   }
 
@@ -35,6 +36,10 @@ class MovenetNode : public Node {
     options.thresholds.min_keypoint_score = ctx.param<float>("min_keypoint_score");
     options.threads = ctx.param<int>("threads");
     detector_.emplace(model_path(ctx.param<std::string>("model")), options);
+    // cv::dnn allocates and tunes its layers on the first forward pass (several times the later
+    // ones): done here, so a live graph's first frames are not late.
+    if (ctx.param<bool>("warm_up"))
+      detector_->detect(ImageBuffer(options.input_size, options.input_size, PixelFormat::bgr8));
   }
 
   void process(Context& ctx) override {
