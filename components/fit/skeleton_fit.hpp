@@ -69,7 +69,7 @@ struct FrameInput {
 
 // Standard deviations: each residual is (value / sigma), so a residual of 1 is "one sigma off".
 struct FitWeights {
-  double reprojection = 0.02;        // fraction of the person's 2D height (per axis)
+  double reprojection = 0.02;        // fraction of the person's 2D size (larger box side)
   double robust = 2.0;               // Huber threshold, in reprojection sigmas
   double min_confidence = 0.05;      // keypoints below are missing
   double prior_rad = 0.15;           // bone rotation away from the retrieved direction
