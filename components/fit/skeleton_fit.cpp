@@ -330,8 +330,9 @@ std::optional<FittedFrame> LiveFitter::push(const FrameInput& frame) {
     std::vector<WindowFrame> frames;
     for (std::size_t i = begin; i < s.vars.size(); ++i)
       frames.push_back({&s.vars[i], &s.data[i], i < variable_from});
-    const auto summary = detail::solve_window(frames, s.bones, s.bones, s.options,
-                                              {false, s.options.live_iterations});
+    const auto summary =
+        detail::solve_window(frames, s.bones, s.bones, s.options,
+                             {false, s.options.live_iterations, s.options.lag == 0});
     ++s.stats.solves;
     s.stats.iterations += summary.iterations;
     s.stats.initial_cost += summary.initial_cost;

@@ -76,6 +76,8 @@ struct FitWeights {
   double translation_prior_m = 1.0;  // root away from its closed-form start (per axis)
   double bone_accel_m = 0.015;       // bone-vector acceleration (world), metres / frame²
   double root_accel_m = 0.01;        // root acceleration (world), metres / frame²
+  double bone_velocity_m = 0.03;     // live, lag 0 only: bone-vector velocity, metres / frame
+  double root_velocity_m = 0.03;     // live, lag 0 only: root velocity, metres / frame
   double knee_limit = 0.05;          // sine of a backwards knee bend
   double bone_prior_m = 0.01;        // bone length away from its initial value (full mode)
   double symmetry_m = 0.005;         // left and right bones of a pair

@@ -83,11 +83,17 @@ struct PriorCost {
   }
 };
 
-// Second difference of one bone vector in the world (three frames).
+// Second difference of one bone vector in the world (three frames): c = (1, -2, 1); or, with
+// c = (0, -1, 1), the first difference of the last two.
+using Difference = std::array<double, 3>;
+constexpr Difference kAcceleration = {1.0, -2.0, 1.0};
+constexpr Difference kVelocity = {0.0, -1.0, 1.0};
+
 struct BoneAccelCost {
   const FrameData* f[3];
   int bone;
   double scale;  // initial bone length / sigma
+  Difference c;
   template <typename T>
   bool operator()(const T* w0, const T* w1, const T* w2, T* r) const {
     const T* w[3] = {w0, w1, w2};
@@ -100,7 +106,7 @@ struct BoneAccelCost {
                         T(f[i]->rotation[3 * row + 2]) * d[2];
     }
     for (int k = 0; k < 3; ++k)
-      r[k] = (world[0][k] - T(2.0) * world[1][k] + world[2][k]) * T(scale);
+      r[k] = (T(c[0]) * world[0][k] + T(c[1]) * world[1][k] + T(c[2]) * world[2][k]) * T(scale);
     return true;
   }
 };
@@ -108,13 +114,15 @@ struct BoneAccelCost {
 struct RootAccelCost {
   const FrameData* f[3];
   double inv_sigma;
+  Difference c;
   template <typename T>
   bool operator()(const T* t0, const T* t1, const T* t2, T* r) const {
-    T a[3], b[3], c[3];
+    T a[3], b[3], e[3];
     to_world(*f[0], t0, a);
     to_world(*f[1], t1, b);
-    to_world(*f[2], t2, c);
-    for (int k = 0; k < 3; ++k) r[k] = (a[k] - T(2.0) * b[k] + c[k]) * T(inv_sigma);
+    to_world(*f[2], t2, e);
+    for (int k = 0; k < 3; ++k)
+      r[k] = (T(c[0]) * a[k] + T(c[1]) * b[k] + T(c[2]) * e[k]) * T(inv_sigma);
     return true;
   }
 };
@@ -337,22 +345,27 @@ WindowSummary solve_window(std::span<const WindowFrame> frames, Bones& bones,
       problem.AddResidualBlock(cost.release(), nullptr, blocks);
     }
   }
+  // Smoothness: accelerations, or velocities when only the newest frame is free (live, lag 0:
+  // anchoring it by the acceleration to two frozen frames extrapolates their motion).
+  const Difference& diff = solve.velocity_smoothing ? kVelocity : kAcceleration;
+  const double root_sigma = solve.velocity_smoothing ? wt.root_velocity_m : wt.root_accel_m;
+  const double bone_sigma = solve.velocity_smoothing ? wt.bone_velocity_m : wt.bone_accel_m;
   for (std::size_t i = 0; i + 2 < frames.size(); ++i) {
     const WindowFrame* f[3] = {&frames[i], &frames[i + 1], &frames[i + 2]};
     if (f[0]->constant && f[1]->constant && f[2]->constant) continue;
     problem.AddResidualBlock(
         std::make_unique<ceres::AutoDiffCostFunction<RootAccelCost, 3, 3, 3, 3>>(
             std::make_unique<RootAccelCost>(
-                RootAccelCost{{f[0]->data, f[1]->data, f[2]->data}, 1.0 / wt.root_accel_m})
+                RootAccelCost{{f[0]->data, f[1]->data, f[2]->data}, 1.0 / root_sigma, diff})
                 .release())
             .release(),
         nullptr, f[0]->vars->t.data(), f[1]->vars->t.data(), f[2]->vars->t.data());
     for (int b = 0; b < kBones; ++b)
       problem.AddResidualBlock(
           std::make_unique<ceres::AutoDiffCostFunction<BoneAccelCost, 3, 3, 3, 3>>(
-              std::make_unique<BoneAccelCost>(BoneAccelCost{{f[0]->data, f[1]->data, f[2]->data},
-                                                            b,
-                                                            initial_bones[b] / wt.bone_accel_m})
+              std::make_unique<BoneAccelCost>(
+                  BoneAccelCost{
+                      {f[0]->data, f[1]->data, f[2]->data}, b, initial_bones[b] / bone_sigma, diff})
                   .release())
               .release(),
           nullptr, f[0]->vars->w[b].data(), f[1]->vars->w[b].data(), f[2]->vars->w[b].data());

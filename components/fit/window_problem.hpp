@@ -53,6 +53,7 @@ struct WindowFrame {
 struct WindowSolve {
   bool solve_bones = false;
   int max_iterations = 20;
+  bool velocity_smoothing = false;  // first differences instead of second ones
 };
 
 struct WindowSummary {

@@ -98,6 +98,9 @@ int main(int argc, char** argv) {
       .option("live-iterations", "N", "live mode: solver iterations per frame", "8")
       .option("clearance", "M", "ankle height over the ground plane", "0.07")
       .flag("all-cameras", "all 20 protocol cameras (default: the quick set, 2 yaws x 4 families)")
+      .flag("all-conditions",
+            "the protocol's five conditions (noise 0, 1, 2, 5 %, 2 % with 10 % drop-out); "
+            "default: 0 and 2 %")
       .flag("no-ground", "no ground-plane term")
       .flag("no-contact", "no foot-contact (no sliding) term")
       .flag("fixed-bones", "full mode: bone lengths fixed at the retrieved poses' medians")
@@ -105,6 +108,7 @@ int main(int argc, char** argv) {
       .option("reprojection", "F", "reprojection sigma, fraction of the 2D height", "0.02")
       .option("bone-accel", "M", "sigma of bone-vector acceleration, m/frame²", "0.015")
       .option("root-accel", "M", "sigma of root acceleration, m/frame²", "0.01")
+      .option("velocity", "M", "live lag 0: sigma of bone and root velocity, m/frame", "0.03")
       .option("translation-prior", "M", "sigma of the root from its closed-form start", "1.0")
       .option("bone-prior", "M", "full mode: sigma of a bone length from its initial value",
               "0.01");
@@ -120,7 +124,7 @@ int main(int argc, char** argv) {
       for (auto& t : truth)
         if (t.world.size() > static_cast<std::size_t>(n)) t.world.resize(n);
     const auto cameras = eval::default_cameras(!args.has("all-cameras"));
-    const auto conditions = eval::default_conditions(true);
+    const auto conditions = eval::default_conditions(!args.has("all-conditions"));
     const eval::Image image;
     const recon::Pinhole pinhole =
         recon::Pinhole::from_fov(image.width, image.height, image.horizontal_fov_deg);
@@ -148,6 +152,7 @@ int main(int argc, char** argv) {
     options.weights.root_accel_m = args.number("root-accel");
     options.weights.bone_prior_m = args.number("bone-prior");
     options.weights.translation_prior_m = args.number("translation-prior");
+    options.weights.bone_velocity_m = options.weights.root_velocity_m = args.number("velocity");
     const bool use_contact = !args.has("no-contact");
 
     const std::vector<std::string> methods = {"truth", "retrieval only", "+ fit, full sequence",
