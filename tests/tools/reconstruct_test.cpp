@@ -78,7 +78,8 @@ TEST_F(ReconstructTest, DamagedInputIsReportedAndEveryFrameIsWritten) {
       const auto root = p.at("joints").at("root");
       EXPECT_EQ(root[0].get<double>(), 0.0);  // root-relative
       const auto head = p.at("joints").at("head");
-      EXPECT_LT(head[1].get<double>(), -0.15);  // the head is above the root (y down), seated people too
+      EXPECT_LT(head[1].get<double>(),
+                -0.15);  // the head is above the root (y down), seated people too
     }
     if (i == 7 || i == 12) {
       EXPECT_TRUE(j.at("people").empty()) << "frame " << i;
@@ -114,6 +115,30 @@ TEST_F(ReconstructTest, MissingDatabaseOrInputGivesAClearError) {
                         dir_->file("y")});
   EXPECT_EQ(no_input.wait(30s), 1);
   EXPECT_NE(no_input.err().find("nowhere"), std::string::npos) << no_input.err();
+}
+
+// --layout-offsets auto re-scores the candidates in BODY_25's own joint definition: a real
+// change of the output, every frame still written; a damaged offsets file stops the run by name.
+TEST_F(ReconstructTest, LayoutOffsetsChangeTheMatchAndABadFileIsNamed) {
+  const auto run = [&](const std::string& name, const std::string& setting) {
+    test::Mocap r(*dir_, name,
+                  {"reconstruct", (dir_->path() / "input").string(), "--db", dir_->file("db.mdb"),
+                   "--out", dir_->file(name), "--layout-offsets", setting});
+    const auto code = r.wait(120s);  // before reading stderr: argument order is unspecified
+    return std::make_pair(code, r.err());
+  };
+  const auto [off_code, off_err] = run("off", "off");
+  ASSERT_EQ(off_code, 0) << off_err;
+  const auto [auto_code, auto_err] = run("auto", "auto");
+  ASSERT_EQ(auto_code, 0) << auto_err;
+  const auto off = test::read_lines(dir_->file("off") + "/poses.jsonl");
+  const auto with = test::read_lines(dir_->file("auto") + "/poses.jsonl");
+  EXPECT_EQ(off.size(), with.size());
+  EXPECT_NE(off, with);
+  test::write_file(dir_->file("bad.yaml"), "format: mocap-layout-offsets/1\nlayout: BODY_25\n");
+  const auto [bad_code, bad_err] = run("bad", dir_->file("bad.yaml"));
+  EXPECT_NE(bad_code, 0);
+  EXPECT_NE(bad_err.find("bad.yaml"), std::string::npos) << bad_err;
 }
 
 }  // namespace

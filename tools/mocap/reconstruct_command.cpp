@@ -20,12 +20,15 @@
 #include "cli_args.hpp"
 #include "commands.hpp"
 #include "core/input_error.hpp"
+#include "core/keypoint_layout.hpp"
+#include "core/messages.hpp"
 #include "detect/model_files.hpp"
 #include "eval_report.hpp"
 #include "graph/graph_spec.hpp"
 #include "graph/plugins.hpp"
 #include "graph/validation.hpp"
 #include "graph_runner.hpp"
+#include "io/openpose_json.hpp"
 #include "progress_bar.hpp"
 #include "video/video_source.hpp"
 
@@ -128,7 +131,22 @@ void check_detector_model(const graph::GraphSpec& spec) {
   }
 }
 
-void configure(graph::GraphSpec& spec, const Args& args, const fs::path& out) {
+// What --layout-offsets means for the matcher: auto names the input's layout (MoveNet's COCO-17
+// for video; for OpenPose JSON, the layout of the folder's first file), whose file in
+// calibration/layouts/ is then used; off and files pass through.
+std::string matcher_layout_offsets(const std::string& setting, const std::string& input,
+                                   InputKind kind) {
+  if (setting != "auto") return setting;
+  if (kind == InputKind::video) return std::string(layout(LayoutId::coco17).name);
+  std::vector<fs::path> files;
+  for (const auto& e : fs::directory_iterator(input))
+    if (e.path().filename().string().ends_with("_keypoints.json")) files.push_back(e.path());
+  if (files.empty()) return "off";
+  const People2D first = io::read_openpose_file(*std::min_element(files.begin(), files.end()));
+  return std::string(layout(first.layout).name);
+}
+
+void configure(graph::GraphSpec& spec, const Args& args, const fs::path& out, InputKind kind) {
   set_param(spec, "source.openpose_json", "path", args.positionals()[0]);
   const std::string fps = args.has("fps") ? args.get("fps") : "30";
   for (const char* type : {"source.openpose_json", "sink.bvh", "sink.overlay"})
@@ -138,7 +156,8 @@ void configure(graph::GraphSpec& spec, const Args& args, const fs::path& out) {
     set_param(spec, type, "db", args.get("db"));
   }
   set_param(spec, "recon.temporal_selector", "mode", args.get("mode"));
-  set_param(spec, "recon.scaler", "layout_offsets", args.get("layout-offsets"));
+  set_param(spec, "recon.matcher", "layout_offsets",
+            matcher_layout_offsets(args.get("layout-offsets"), args.positionals()[0], kind));
   if (args.has("image-size")) {
     const std::string size = args.get("image-size");
     const auto x = size.find('x');
@@ -220,8 +239,9 @@ int reconstruct_command(int argc, char** argv) {
       .option("mode", "NAME",
               "temporal selection: path (Viterbi, lag 8), greedy (the paper) or nearest", "path")
       .option("layout-offsets", "auto|off|FILE",
-              "move the input layout's keypoints onto the canonical joint centres before "
-              "matching (auto: calibration/layouts/<layout>.yaml; docs/keypoint-layouts.md)",
+              "compare the database's candidates in the input layout's own joint definition "
+              "(auto: calibration/layouts/<layout>.yaml; docs/keypoint-layouts.md; about "
+              "twice the matching time)",
               "off")
       .option("graph", "FILE",
               "graph to run (default: graphs/monocular_json.yaml for OpenPose JSON, "
@@ -251,7 +271,7 @@ int reconstruct_command(int argc, char** argv) {
              (kind == InputKind::video ? "monocular_video.yaml" : "monocular_json.yaml"))
                 .string();
   graph::GraphSpec spec = graph::load_graph_file(graph_file);
-  configure(spec, args, out);
+  configure(spec, args, out, kind);
   if (kind == InputKind::video) configure_video(spec, args, info);
   graph::apply_overrides(spec, args.all("set"));
   check_detector_model(spec);
