@@ -1,0 +1,201 @@
+#include "camera/camera_file.hpp"
+
+#include <cmath>
+#include <numbers>
+#include <random>
+#include <stdexcept>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "core/input_error.hpp"
+#include "support/files.hpp"
+
+namespace mocap::camera {
+namespace {
+
+// A camera file as OpenCV's calibration sample writes it.
+const char* kOpenCvFile = R"(%YAML:1.0
+---
+calibration_time: "Sun 22 Nov 2026"
+nframes: 13
+image_width: 640
+image_height: 480
+board_width: 9
+board_height: 6
+square_size: 1.
+flags: 0
+camera_matrix: !!opencv-matrix
+   rows: 3
+   cols: 3
+   dt: d
+   data: [ 5.3591573396163199e+02, 0., 3.4228315473308373e+02, 0.,
+       5.3591573396163199e+02, 2.3557082909788173e+02, 0., 0., 1. ]
+distortion_coefficients: !!opencv-matrix
+   rows: 5
+   cols: 1
+   dt: d
+   data: [ -2.6637260909660682e-01, -3.8588898922304653e-02,
+       1.7831947042852964e-03, -2.8122100441115472e-04,
+       2.3839153080878486e-01 ]
+avg_reprojection_error: 3.9259098975581364e-01
+)";
+
+std::string error_of(const std::string& path) {
+  try {
+    read_camera_file(path);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+TEST(CameraFile, ReadsOpenCvCalibrationOutput) {
+  test::TempDir dir;
+  test::write_file(dir.file("cam.yml"), kOpenCvFile);
+  const CameraIntrinsics c = read_camera_file(dir.file("cam.yml"));
+  EXPECT_EQ(c.width, 640);
+  EXPECT_EQ(c.height, 480);
+  EXPECT_DOUBLE_EQ(c.fx(), 5.3591573396163199e+02);
+  EXPECT_DOUBLE_EQ(c.cx(), 3.4228315473308373e+02);
+  EXPECT_DOUBLE_EQ(c.cy(), 2.3557082909788173e+02);
+  EXPECT_DOUBLE_EQ(c.K[8], 1.0);
+  ASSERT_EQ(c.distortion.size(), 5u);
+  EXPECT_DOUBLE_EQ(c.distortion[0], -2.6637260909660682e-01);
+  EXPECT_DOUBLE_EQ(c.distortion[4], 2.3839153080878486e-01);
+}
+
+TEST(CameraFile, WriteThenReadIsEqual) {
+  test::TempDir dir;
+  CameraIntrinsics c;
+  c.width = 1920;
+  c.height = 1080;
+  c.K = {1401.25, 0.0, 961.5, 0.0, 1399.75, 540.125, 0.0, 0.0, 1.0};
+  c.distortion = {-0.1, 0.02, 0.001, -0.0005, 0.003};
+  write_camera_file(dir.file("c.yaml"), c, 0.25);
+  EXPECT_EQ(read_camera_file(dir.file("c.yaml")), c);
+  EXPECT_NE(test::read_file(dir.file("c.yaml")).find("avg_reprojection_error"), std::string::npos);
+}
+
+TEST(CameraFile, FromFov) {
+  const CameraIntrinsics c = from_fov(640, 480, 90.0);
+  EXPECT_NEAR(c.fx(), 320.0, 1e-9);
+  EXPECT_NEAR(c.fy(), 320.0, 1e-9);
+  EXPECT_NEAR(c.cx(), 319.5, 1e-12);
+  EXPECT_NEAR(c.cy(), 239.5, 1e-12);
+  EXPECT_EQ(c.distortion, std::vector<double>(5, 0.0));
+  // 60 degrees: f = (w/2) / tan(30 deg).
+  EXPECT_NEAR(from_fov(1000, 500, 60.0).fx(), 500.0 / std::tan(std::numbers::pi / 6), 1e-9);
+  EXPECT_THROW(from_fov(0, 480, 60.0), std::invalid_argument);
+  EXPECT_THROW(from_fov(640, 480, 180.0), std::invalid_argument);
+  EXPECT_THROW(from_fov(640, 480, 0.0), std::invalid_argument);
+}
+
+TEST(CameraFile, FromFovRoundTrips) {
+  test::TempDir dir;
+  const CameraIntrinsics c = from_fov(1280, 720, 70.0);
+  write_camera_file(dir.file("f.yml"), c);
+  EXPECT_EQ(read_camera_file(dir.file("f.yml")), c);
+}
+
+TEST(CameraFile, MissingAndEmptyFilesNameTheFile) {
+  test::TempDir dir;
+  EXPECT_NE(error_of(dir.file("nope.yml")).find("nope.yml: no such file"), std::string::npos);
+  test::write_file(dir.file("empty.yml"), "");
+  EXPECT_NE(error_of(dir.file("empty.yml")).find("empty.yml: empty file"), std::string::npos);
+}
+
+TEST(CameraFile, MissingKeysAreNamed) {
+  test::TempDir dir;
+  const std::string full = kOpenCvFile;
+  for (const std::string key :
+       {"image_width", "image_height", "camera_matrix", "distortion_coefficients"}) {
+    std::string text = full;
+    const size_t at = text.find(key + ":");
+    ASSERT_NE(at, std::string::npos);
+    text.replace(at, key.size(), "renamed_" + key);
+    const std::string path = dir.file("no_" + key + ".yml");
+    test::write_file(path, text);
+    const std::string error = error_of(path);
+    EXPECT_NE(error.find(path), std::string::npos) << error;
+    EXPECT_NE(error.find("missing key '" + key + "'"), std::string::npos) << error;
+  }
+}
+
+TEST(CameraFile, WrongShapesAreNamed) {
+  test::TempDir dir;
+  // camera_matrix 3x2 with six values.
+  std::string text = std::string(kOpenCvFile);
+  const size_t k = text.find("camera_matrix");
+  const size_t d = text.find("distortion_coefficients");
+  text.replace(k, d - k,
+               "camera_matrix: !!opencv-matrix\n   rows: 3\n   cols: 2\n   dt: d\n"
+               "   data: [ 500., 0., 0., 500., 0., 0. ]\n");
+  test::write_file(dir.file("k.yml"), text);
+  std::string error = error_of(dir.file("k.yml"));
+  EXPECT_NE(error.find("k.yml: key 'camera_matrix' must be 3x3, not 3x2"), std::string::npos)
+      << error;
+
+  // A 2x3 distortion matrix.
+  text = kOpenCvFile;
+  const size_t d2 = text.find("distortion_coefficients");
+  const size_t e = text.find("avg_reprojection_error");
+  text.replace(d2, e - d2,
+               "distortion_coefficients: !!opencv-matrix\n   rows: 2\n   cols: 3\n   dt: d\n"
+               "   data: [ 0., 0., 0., 0., 0., 0. ]\n");
+  test::write_file(dir.file("d.yml"), text);
+  error = error_of(dir.file("d.yml"));
+  EXPECT_NE(error.find("d.yml: key 'distortion_coefficients' must be a vector"), std::string::npos)
+      << error;
+
+  // A scalar where a matrix belongs, and a string where a size belongs.
+  text = kOpenCvFile;
+  text.replace(text.find("image_width: 640"), 16, "image_width: wide");
+  test::write_file(dir.file("w.yml"), text);
+  error = error_of(dir.file("w.yml"));
+  EXPECT_NE(error.find("w.yml: key 'image_width' is not an integer"), std::string::npos) << error;
+  test::write_file(dir.file("s.yml"),
+                   "%YAML:1.0\n---\nimage_width: 640\nimage_height: 480\ncamera_matrix: 3\n"
+                   "distortion_coefficients: 0\n");
+  error = error_of(dir.file("s.yml"));
+  EXPECT_NE(error.find("s.yml: key 'camera_matrix'"), std::string::npos) << error;
+}
+
+TEST(CameraFile, TruncatedFilesGiveAnErrorNamingTheFile) {
+  test::TempDir dir;
+  // Every cut before the optional last key loses some required data.
+  const std::string full = kOpenCvFile;
+  const size_t last = full.find("avg_reprojection_error");
+  for (size_t n = 1; n < last; n += 7) {
+    const std::string path = dir.file("t.yml");
+    test::write_file(path, full.substr(0, n));
+    try {
+      read_camera_file(path);
+      ADD_FAILURE() << "no error for the first " << n << " bytes";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+    }
+  }
+}
+
+TEST(CameraFile, RandomBytesGiveAnErrorNamingTheFile) {
+  test::TempDir dir;
+  std::mt19937 rng(7);
+  for (int trial = 0; trial < 50; ++trial) {
+    std::string bytes(1 + rng() % 600, '\0');
+    for (char& c : bytes) c = static_cast<char>(rng() % 256);
+    std::string name = std::to_string(trial);
+    name += ".yml";
+    const std::string path = dir.file(name);
+    test::write_file(path, bytes);
+    try {
+      read_camera_file(path);
+      ADD_FAILURE() << "no error for random file " << trial;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+    }
+  }
+}
+
+}  // namespace
+}  // namespace mocap::camera
