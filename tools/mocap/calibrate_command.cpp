@@ -1,16 +1,23 @@
 // `mocap calibrate layout`: measures where a keypoint layout puts its joints relative to the
 // canonical body's joint centres (eval/layout_calibration.hpp) and writes the coefficients of the
 // correction (recon/layout_offsets.hpp) as calibration/layouts/<layout>.yaml.
+// `mocap calibrate intrinsics`: camera intrinsics from chessboard images or a video
+// (camera/chessboard_calibration.hpp), written as an OpenCV YAML camera file.
 
 #include <algorithm>
+#include <cctype>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
 #include <sstream>
+#include <tuple>
+#include <utility>
 
 #include <glm/geometric.hpp>
 
+#include "camera/camera_file.hpp"
+#include "camera/chessboard_calibration.hpp"
 #include "cli_args.hpp"
 #include "commands.hpp"
 #include "core/input_error.hpp"
@@ -247,12 +254,110 @@ int layout_command(int argc, char** argv) {
   return 0;
 }
 
+bool is_image_file(const fs::path& p) {
+  std::string ext = p.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  for (const char* known :
+       {".jpg", ".jpeg", ".png", ".bmp", ".tif", ".tiff", ".ppm", ".pgm", ".pbm", ".webp"})
+    if (ext == known) return true;
+  return false;
+}
+
+// "9x6" -> {9, 6}.
+std::pair<int, int> board_size(const std::string& text) {
+  const auto x = text.find('x');
+  try {
+    if (x == std::string::npos) throw std::invalid_argument(text);
+    std::size_t used = 0;
+    const int columns = std::stoi(text.substr(0, x), &used);
+    if (used != x) throw std::invalid_argument(text);
+    const int rows = std::stoi(text.substr(x + 1), &used);
+    if (used != text.size() - x - 1) throw std::invalid_argument(text);
+    if (columns < 2 || rows < 2 || columns > 100 || rows > 100) throw std::invalid_argument(text);
+    return {columns, rows};
+  } catch (const std::logic_error&) {
+    throw InputError("--board",
+                     "'" + text + "' is not COLUMNSxROWS inner corners (2..100 each), e.g. 9x6");
+  }
+}
+
+int intrinsics_command(int argc, char** argv) {
+  Args args("mocap calibrate intrinsics IMAGES_OR_VIDEO... --board 9x6 --square MM --out FILE",
+            "Calibrates a camera's intrinsics from chessboard images (files, or folders of "
+            "them) or one video\n(every --step-th frame) with OpenCV, prints the views used and "
+            "skipped and the RMS reprojection\nerror, and writes an OpenCV YAML camera file "
+            "(camera_matrix, distortion_coefficients,\nimage_width, image_height).");
+  args.positional("inputs", "chessboard images, folders of images, or one video file", true)
+      .option("board", "CxR", "inner corners of the chessboard, columns x rows", "9x6")
+      .option("square", "MM", "side of one square in millimetres", "25")
+      .option("step", "N", "try every Nth frame of a video", "15")
+      .option("out", "FILE", "where to write the camera file (nothing written when absent)");
+  int code = 0;
+  if (!args.parse(argc, argv, code)) return code;
+  camera::ChessboardOptions options;
+  std::tie(options.inner_columns, options.inner_rows) = board_size(args.get("board"));
+  options.square_mm = args.number("square");
+  if (!(options.square_mm > 0)) throw InputError("--square", "must be positive");
+  const long step = args.integer("step");
+  if (step < 1) throw InputError("--step", "must be at least 1");
+  options.video_step = static_cast<int>(step);
+
+  std::vector<std::string> images;
+  std::string video;
+  for (const std::string& input : args.positionals()) {
+    std::error_code ec;
+    if (fs::is_directory(input, ec)) {
+      std::vector<std::string> found;
+      for (const auto& entry : fs::directory_iterator(input, ec))
+        if (entry.is_regular_file() && is_image_file(entry.path()))
+          found.push_back(entry.path().string());
+      if (found.empty()) throw InputError(input, "no image files in this folder");
+      std::sort(found.begin(), found.end());
+      images.insert(images.end(), found.begin(), found.end());
+    } else if (!fs::exists(input, ec)) {
+      throw InputError(input, "no such file");
+    } else if (is_image_file(input)) {
+      images.push_back(input);
+    } else if (args.positionals().size() == 1) {
+      video = input;
+    } else {
+      throw InputError(input, "not an image file (a video must be the only input)");
+    }
+  }
+  const camera::ChessboardCalibration result =
+      video.empty() ? camera::calibrate_chessboard_images(images, options)
+                    : camera::calibrate_chessboard_video(video, options);
+  std::cout << "board " << options.inner_columns << "x" << options.inner_rows
+            << " inner corners, squares " << options.square_mm << " mm\n";
+  std::cout << "used " << result.used.size() << " views:\n";
+  for (const auto& name : result.used) std::cout << "  " << name << "\n";
+  std::cout << "skipped " << result.skipped.size() << " views:\n";
+  for (const auto& s : result.skipped) std::cout << "  " << s.name << ": " << s.reason << "\n";
+  const camera::CameraIntrinsics& c = result.camera;
+  std::cout << "image " << c.width << "x" << c.height << "\n"
+            << "fx " << fixed(c.fx(), 2) << "  fy " << fixed(c.fy(), 2) << "  cx "
+            << fixed(c.cx(), 2) << "  cy " << fixed(c.cy(), 2) << "\ndistortion";
+  for (double d : c.distortion) std::cout << " " << fixed(d, 5);
+  std::cout << "\nRMS reprojection error " << fixed(result.rms_px, 3) << " px\n";
+  if (args.has("out")) {
+    const fs::path out = args.get("out");
+    if (out.has_parent_path()) fs::create_directories(out.parent_path());
+    camera::write_camera_file(out.string(), c, result.rms_px);
+    camera::read_camera_file(out.string());  // what was written reads back
+    std::cout << "wrote " << out.string() << "\n";
+  }
+  return 0;
+}
+
 }  // namespace
 
 int calibrate_command(int argc, char** argv) {
   static constexpr Subcommand kSubcommands[] = {
       {"layout", "fit where a keypoint layout puts its joints (calibration/layouts/)",
        layout_command},
+      {"intrinsics", "camera intrinsics from chessboard images or a video (OpenCV camera file)",
+       intrinsics_command},
   };
   return run_subcommand("mocap calibrate", kSubcommands, argc, argv);
 }

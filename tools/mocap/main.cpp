@@ -25,7 +25,7 @@ constexpr Command kCommands[] = {
     {"eval", "measure accuracy: virtual-video and HumanEva-I protocols", mocap::cli::eval_command},
     {"camera", "GigE/USB3 Vision cameras (Aravis): list them, grab frames to files",
      mocap::cli::camera_command},
-    {"calibrate", "fit where a keypoint layout puts its joints (calibration/layouts/)",
+    {"calibrate", "keypoint layout offsets (calibration/layouts/) and camera intrinsics",
      mocap::cli::calibrate_command},
 };
 
