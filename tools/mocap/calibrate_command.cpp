@@ -359,7 +359,7 @@ int calibrate_command(int argc, char** argv) {
       {"intrinsics", "camera intrinsics from chessboard images or a video (OpenCV camera file)",
        intrinsics_command},
   };
-  return run_subcommand("mocap calibrate", kSubcommands, argc, argv);
+  return run_subcommand("calibrate", kSubcommands, argc, argv);
 }
 
 }  // namespace mocap::cli

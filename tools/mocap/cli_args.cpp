@@ -1,5 +1,6 @@
 #include "cli_args.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <iostream>
@@ -163,10 +164,10 @@ int run_subcommand(std::string_view command, std::span<const Subcommand> subcomm
   for (std::size_t i = 0; i < subcommands.size(); ++i)
     usage << (i ? "|" : "") << subcommands[i].name;
   usage << " ...\n\n";
-  for (const auto& s : subcommands) {
-    usage << "  " << s.name << std::string(s.name.size() < 10 ? 10 - s.name.size() : 1, ' ')
-          << s.summary << "\n";
-  }
+  std::size_t width = 0;
+  for (const auto& s : subcommands) width = std::max(width, s.name.size());
+  for (const auto& s : subcommands)
+    usage << "  " << s.name << std::string(width + 2 - s.name.size(), ' ') << s.summary << "\n";
   usage << "\nRun 'mocap " << command << " SUBCOMMAND --help' for options.\n";
   if (argc < 1) {
     std::cerr << usage.str();
