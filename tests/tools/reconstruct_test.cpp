@@ -6,6 +6,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "camera/camera_file.hpp"
 #include "core/body15.hpp"
 #include "motion/bvh.hpp"
 #include "support/mocap_process.hpp"
@@ -139,6 +140,38 @@ TEST_F(ReconstructTest, LayoutOffsetsChangeTheMatchAndABadFileIsNamed) {
   const auto [bad_code, bad_err] = run("bad", dir_->file("bad.yaml"));
   EXPECT_NE(bad_code, 0);
   EXPECT_NE(bad_err.find("bad.yaml"), std::string::npos) << bad_err;
+}
+
+// A camera file holding exactly what --image-size and --hfov assume gives the same output; a
+// truncated camera file stops the run naming it.
+TEST_F(ReconstructTest, ACameraFileReplacesImageSizeAndFieldOfView) {
+  const auto run = [&](const std::string& name, std::vector<std::string> extra) {
+    std::vector<std::string> argv{"reconstruct", (dir_->path() / "input").string(),
+                                  "--db",        dir_->file("db.mdb"),
+                                  "--out",       dir_->file(name)};
+    argv.insert(argv.end(), extra.begin(), extra.end());
+    test::Mocap r(*dir_, name, argv);
+    const auto code = r.wait(120s);  // before reading stderr: argument order is unspecified
+    return std::make_pair(code, r.err());
+  };
+  camera::CameraIntrinsics same = camera::from_fov(1920, 1080, 50.0);
+  same.K[2] = 960.0;  // --image-size puts the principal point at w/2, h/2 (OpenCV: (w-1)/2)
+  same.K[5] = 540.0;
+  camera::write_camera_file(dir_->file("cam.yml"), same);
+  const auto [fov_code, fov_err] = run("fov", {"--image-size", "1920x1080", "--hfov", "50"});
+  ASSERT_EQ(fov_code, 0) << fov_err;
+  const auto [cam_code, cam_err] = run("cam", {"--camera", dir_->file("cam.yml")});
+  ASSERT_EQ(cam_code, 0) << cam_err;
+  const auto [none_code, none_err] = run("none", {});
+  ASSERT_EQ(none_code, 0) << none_err;
+  const auto fov = test::read_lines(dir_->file("fov") + "/poses.jsonl");
+  EXPECT_EQ(fov, test::read_lines(dir_->file("cam") + "/poses.jsonl"));
+  EXPECT_NE(fov, test::read_lines(dir_->file("none") + "/poses.jsonl"));  // the ray matters
+  const std::string text = test::read_file(dir_->file("cam.yml"));
+  test::write_file(dir_->file("cut.yml"), text.substr(0, text.size() / 3));
+  const auto [cut_code, cut_err] = run("cut", {"--camera", dir_->file("cut.yml")});
+  EXPECT_NE(cut_code, 0);
+  EXPECT_NE(cut_err.find("cut.yml"), std::string::npos) << cut_err;
 }
 
 }  // namespace

@@ -170,6 +170,7 @@ void configure(graph::GraphSpec& spec, const Args& args, const fs::path& out, In
     set_param(spec, "recon.temporal_selector", "image_height", size.substr(x + 1));
     set_param(spec, "recon.temporal_selector", "hfov_deg", args.get("hfov"));
   }
+  if (args.has("camera")) set_param(spec, "recon.temporal_selector", "camera", args.get("camera"));
   set_param(spec, "sink.jsonl", "path", (out / "poses.jsonl").string());
   set_param(spec, "sink.bvh", "dir", out.string());
   set_param(spec, "sink.overlay", "video", (out / "overlay.mp4").string());
@@ -236,6 +237,9 @@ int reconstruct_command(int argc, char** argv) {
               "OpenPose JSON: size of the images the keypoints came from; turns each pose onto "
               "its camera ray (off when absent; videos: always on, their own size)")
       .option("hfov", "DEG", "horizontal field of view assumed with --image-size", "60")
+      .option("camera", "FILE",
+              "calibrated camera (OpenCV YAML from `mocap calibrate intrinsics`): its matrix and "
+              "lens distortion replace --image-size/--hfov for the ray through each root")
       .option("mode", "NAME",
               "temporal selection: path (Viterbi, lag 8), greedy (the paper) or nearest", "path")
       .option("layout-offsets", "auto|off|FILE",

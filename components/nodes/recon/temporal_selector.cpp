@@ -7,6 +7,9 @@
 #include <map>
 #include <optional>
 
+#include "camera/camera_file.hpp"
+#include "camera/undistortion.hpp"
+#include "core/input_error.hpp"
 #include "graph/registry.hpp"
 #include "posedb/database.hpp"
 #include "recon/sequence_reconstruction.hpp"
@@ -53,6 +56,9 @@ class TemporalSelectorNode : public Node {
     c.param<int>("image_height", 0, "input image height in pixels", {0, 100000});
     c.param<double>("hfov_deg", 60.0, "horizontal field of view assumed for the camera",
                     {1.0, 179.0});
+    c.param<std::string>("camera", "",
+                         "calibrated camera file (OpenCV YAML, `mocap calibrate intrinsics`): "
+                         "its matrix and distortion replace image_width/height and hfov_deg");
   }
 
   void open(Context& ctx) override {
@@ -69,8 +75,17 @@ class TemporalSelectorNode : public Node {
     lag_ = mode_ == "path" ? ctx.param<int>("lag") : 0;
     max_missed_ = ctx.param<int>("max_missed");
     const int width = ctx.param<int>("image_width"), height = ctx.param<int>("image_height");
-    if (width > 0 && height > 0)
+    if (const std::string file = ctx.param<std::string>("camera"); !file.empty()) {
+      lens_ = camera::read_camera_file(file);
+      if (width > 0 && height > 0 && (width != lens_->width || height != lens_->height))
+        throw InputError(file, "is a camera of " + std::to_string(lens_->width) + "x" +
+                                   std::to_string(lens_->height) + " pixels, the input is " +
+                                   std::to_string(width) + "x" + std::to_string(height));
+      camera_ = {static_cast<float>(lens_->fx()), static_cast<float>(lens_->fy()),
+                 static_cast<float>(lens_->cx()), static_cast<float>(lens_->cy())};
+    } else if (width > 0 && height > 0) {
       camera_ = recon::Pinhole::from_fov(width, height, ctx.param<float>("hfov_deg"));
+    }
   }
 
   void process(Context& ctx) override {
@@ -80,7 +95,12 @@ class TemporalSelectorNode : public Node {
     for (const PersonMatch& person : in.people) {
       if (person.id < 0) continue;  // untracked: no history to choose with
       const Keypoint2D& root = person.body[index(Joint::root)];
-      pending_.back().root_pixel[person.id] = {root.x, root.y};
+      if (lens_) {
+        const auto [x, y] = camera::undistort_pixel(*lens_, root.x, root.y);
+        pending_.back().root_pixel[person.id] = {x, y};
+      } else {
+        pending_.back().root_pixel[person.id] = {root.x, root.y};
+      }
       if (person.normalized_ok) {
         posedb::PoseVector query;
         std::copy(person.normalized.begin(), person.normalized.end(), query.begin());
@@ -199,6 +219,7 @@ class TemporalSelectorNode : public Node {
   int lag_ = 0;
   int max_missed_ = 10;
   recon::Pinhole camera_;  // invalid: poses stay as the database cameras see them
+  std::optional<camera::CameraIntrinsics> lens_;  // from a camera file: its distortion too
   bool refine_view_ = true;
   std::map<int, Track> tracks_;
   std::deque<PendingFrame> pending_;
