@@ -6,9 +6,7 @@
 // python3 or its zmq module is missing.
 
 #include <gtest/gtest.h>
-#include <netinet/in.h>
 #include <spawn.h>
-#include <sys/socket.h>
 #include <sys/wait.h>
 #include <unistd.h>
 #include <zmq.h>
@@ -21,6 +19,7 @@
 #include "graph/wire_format.hpp"
 #include "io/openpose_json.hpp"
 #include "support/mocap_process.hpp"
+#include "support/network.hpp"
 
 namespace mocap::test {
 namespace {
@@ -30,18 +29,6 @@ namespace wire = graph::wire;
 
 const char* const kFolder = "../shared/data/eval/openpose_json/json";
 constexpr int kFrames = 60;
-
-int free_tcp_port() {
-  const int fd = socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in address{};
-  address.sin_family = AF_INET;
-  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  bind(fd, reinterpret_cast<sockaddr*>(&address), sizeof address);
-  socklen_t size = sizeof address;
-  getsockname(fd, reinterpret_cast<sockaddr*>(&address), &size);
-  close(fd);
-  return ntohs(address.sin_port);
-}
 
 // `python3 ARGS...` with stderr into a file; waits are bounded, the child is killed at the end.
 class Python {
