@@ -1,10 +1,7 @@
 #include "recon/layout_offsets.hpp"
 
-#include <unistd.h>
-
 #include <cctype>
 #include <charconv>
-#include <climits>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -14,6 +11,7 @@
 #include <vector>
 
 #include "core/input_error.hpp"
+#include "core/install_paths.hpp"
 
 namespace mocap::recon {
 
@@ -193,16 +191,6 @@ class Parser {
   std::string file_;
   long line_ = 0;
 };
-
-fs::path install_root() {
-  char path[PATH_MAX];
-  const ssize_t size = readlink("/proc/self/exe", path, sizeof path - 1);
-  if (size <= 0) return fs::current_path();
-  return fs::path(std::string(path, static_cast<std::size_t>(size)))
-      .parent_path()
-      .parent_path()
-      .parent_path();
-}
 
 glm::vec2 trunk_normal(const glm::vec2&, const glm::vec2&) { return glm::vec2(0.0f); }
 glm::vec3 trunk_normal(const glm::vec3& lateral, const glm::vec3& trunk) {

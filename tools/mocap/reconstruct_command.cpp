@@ -7,7 +7,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <climits>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -20,6 +19,7 @@
 #include "cli_args.hpp"
 #include "commands.hpp"
 #include "core/input_error.hpp"
+#include "core/install_paths.hpp"
 #include "core/keypoint_layout.hpp"
 #include "core/messages.hpp"
 #include "detect/model_files.hpp"
@@ -37,17 +37,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
-
-// The repository (or install) folder: the executable lives in <root>/build/bin.
-fs::path install_root() {
-  char path[PATH_MAX];
-  const ssize_t size = readlink("/proc/self/exe", path, sizeof path - 1);
-  if (size <= 0) return fs::current_path();
-  return fs::path(std::string(path, static_cast<std::size_t>(size)))
-      .parent_path()
-      .parent_path()
-      .parent_path();
-}
 
 std::string default_database() {
   return (install_root() / "build" / "db" / "cmu31_train.mdb").string();

@@ -2,14 +2,12 @@
 // (which drain it and flush the sinks), and prints per-node statistics. A graph with placement
 // runs under a supervisor, one child process per group; `--process NAME` runs one group.
 
-#include <unistd.h>
-
-#include <climits>
 #include <iostream>
 #include <mutex>
 
 #include "cli_args.hpp"
 #include "commands.hpp"
+#include "core/install_paths.hpp"
 #include "graph/plugins.hpp"
 #include "graph/runtime.hpp"
 #include "graph/signals.hpp"
@@ -21,12 +19,7 @@ namespace {
 
 using namespace mocap::graph;
 
-std::string this_program() {
-  char path[PATH_MAX];
-  const ssize_t size = readlink("/proc/self/exe", path, sizeof path - 1);
-  if (size <= 0) throw std::runtime_error("cannot find the mocap executable (/proc/self/exe)");
-  return std::string(path, static_cast<std::size_t>(size));
-}
+std::string this_program() { return executable_path().string(); }
 
 int run_here(const ResolvedGraph& graph, const Args& args) {
   const std::string label =
