@@ -6,8 +6,6 @@
 // python3 or its zmq module is missing.
 
 #include <gtest/gtest.h>
-#include <spawn.h>
-#include <sys/wait.h>
 #include <unistd.h>
 #include <zmq.h>
 
@@ -31,45 +29,11 @@ const char* const kFolder = "../shared/data/eval/openpose_json/json";
 constexpr int kFrames = 60;
 
 // `python3 ARGS...` with stderr into a file; waits are bounded, the child is killed at the end.
-class Python {
+class Python : public ChildProcess {
  public:
-  Python(const TempDir& dir, std::vector<std::string> args) : err_(dir.file("python.err")) {
-    args.insert(args.begin(), MOCAP_PYTHON3);
-    std::vector<char*> argv;
-    for (auto& a : args) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    posix_spawn_file_actions_t files;
-    posix_spawn_file_actions_init(&files);
-    posix_spawn_file_actions_addopen(&files, 2, err_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    const int error = posix_spawn(&pid_, MOCAP_PYTHON3, &files, nullptr, argv.data(), environ);
-    posix_spawn_file_actions_destroy(&files);
-    if (error != 0) throw std::runtime_error("cannot start python3");
-  }
-  ~Python() {
-    if (pid_ > 0) {
-      kill(pid_, SIGKILL);
-      waitpid(pid_, nullptr, 0);
-    }
-  }
-  Python(const Python&) = delete;
-  Python& operator=(const Python&) = delete;
-  std::optional<int> wait(std::chrono::milliseconds timeout) {
-    const auto deadline = std::chrono::steady_clock::now() + timeout;
-    while (std::chrono::steady_clock::now() < deadline) {
-      int status = 0;
-      if (waitpid(pid_, &status, WNOHANG) == pid_) {
-        pid_ = -1;
-        return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-      }
-      std::this_thread::sleep_for(20ms);
-    }
-    return std::nullopt;
-  }
-  std::string err() const { return read_file(err_); }
-
- private:
-  std::string err_;
-  pid_t pid_ = -1;
+  Python(const TempDir& dir, std::vector<std::string> args)
+      : ChildProcess(MOCAP_PYTHON3, std::move(args), "/dev/null", dir.file("python.err"),
+                     environment()) {}
 };
 
 bool python_has_zmq() {

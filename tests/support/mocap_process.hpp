@@ -1,7 +1,7 @@
 #pragma once
-// A child process running the built `mocap` binary (MOCAP_BINARY, defined by the test target),
-// with stdout and stderr in files; every wait is bounded and the child is killed and reaped when
-// the object goes away.
+// Child processes for tests: the built `mocap` binary (MOCAP_BINARY, defined by the test target) or
+// any program, with stdout and stderr in files; every wait is bounded and the child is killed and
+// reaped when the object goes away.
 
 #include <fcntl.h>
 #include <signal.h>
@@ -25,21 +25,17 @@ namespace mocap::test {
 
 using namespace std::chrono_literals;
 
-// A child process running `mocap ARGS...` with stdout and stderr going to files.
-class Mocap {
+// A child process running `program ARGS...` with the given environment, stdout and stderr going
+// to files; killed and reaped when the object goes away.
+class ChildProcess {
  public:
-  Mocap(const TempDir& dir, const std::string& name, std::vector<std::string> args,
-        std::vector<std::string> extra_env = {})
-      : out_(dir.file(name + ".out")), err_(dir.file(name + ".err")) {
-    args.insert(args.begin(), MOCAP_BINARY);
+  ChildProcess(const std::string& program, std::vector<std::string> args, std::string out,
+               std::string err, std::vector<std::string> env)
+      : out_(std::move(out)), err_(std::move(err)) {
+    args.insert(args.begin(), program);
     std::vector<char*> argv;
     for (auto& a : args) argv.push_back(a.data());
     argv.push_back(nullptr);
-    std::vector<std::string> env;
-    for (char** e = environ; *e; ++e) {
-      if (std::strncmp(*e, "MOCAP_", 6) != 0) env.emplace_back(*e);  // no inherited plugin path
-    }
-    env.insert(env.end(), extra_env.begin(), extra_env.end());
     std::vector<char*> envp;
     for (auto& e : env) envp.push_back(e.data());
     envp.push_back(nullptr);
@@ -47,19 +43,20 @@ class Mocap {
     posix_spawn_file_actions_init(&files);
     posix_spawn_file_actions_addopen(&files, 1, out_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
     posix_spawn_file_actions_addopen(&files, 2, err_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    const int error = posix_spawn(&pid_, MOCAP_BINARY, &files, nullptr, argv.data(), envp.data());
+    const int error =
+        posix_spawn(&pid_, program.c_str(), &files, nullptr, argv.data(), envp.data());
     posix_spawn_file_actions_destroy(&files);
     if (error != 0)
-      throw std::runtime_error(std::string("cannot start mocap: ") + std::strerror(error));
+      throw std::runtime_error("cannot start " + program + ": " + std::strerror(error));
   }
-  ~Mocap() {
+  ~ChildProcess() {
     if (pid_ > 0) {
-      kill(pid_, SIGKILL);  // its children follow (PR_SET_PDEATHSIG)
+      kill(pid_, SIGKILL);  // a mocap's children follow (PR_SET_PDEATHSIG)
       waitpid(pid_, nullptr, 0);
     }
   }
-  Mocap(const Mocap&) = delete;
-  Mocap& operator=(const Mocap&) = delete;
+  ChildProcess(const ChildProcess&) = delete;
+  ChildProcess& operator=(const ChildProcess&) = delete;
 
   pid_t pid() const { return pid_; }
   // The exit code (128 + signal when killed), or nullopt after `timeout` (the process is killed).
@@ -75,6 +72,31 @@ class Mocap {
     }
     return std::nullopt;
   }
+  std::string err() const { return read_file(err_); }
+  std::string out() const { return read_file(out_); }
+
+ protected:
+  std::string out_, err_;
+  pid_t pid_ = -1;
+};
+
+// This process's environment, less the variables whose names start with `drop` (if given).
+inline std::vector<std::string> environment(const std::string& drop = "") {
+  std::vector<std::string> env;
+  for (char** e = environ; *e; ++e) {
+    if (drop.empty() || std::strncmp(*e, drop.c_str(), drop.size()) != 0) env.emplace_back(*e);
+  }
+  return env;
+}
+
+// A child process running the built `mocap ARGS...` (no inherited MOCAP_* plugin path).
+class Mocap : public ChildProcess {
+ public:
+  Mocap(const TempDir& dir, const std::string& name, std::vector<std::string> args,
+        std::vector<std::string> extra_env = {})
+      : ChildProcess(MOCAP_BINARY, std::move(args), dir.file(name + ".out"),
+                     dir.file(name + ".err"), with(environment("MOCAP_"), extra_env)) {}
+
   // Waits until the process has `signal` blocked (the graph's signal watcher takes stop signals
   // with sigtimedwait): a signal sent before that would kill it with the default action.
   bool wait_until_blocking(int signal, std::chrono::milliseconds timeout) const {
@@ -90,8 +112,6 @@ class Mocap {
     }
     return false;
   }
-  std::string err() const { return read_file(err_); }
-  std::string out() const { return read_file(out_); }
   // Waits until stderr matches `pattern`; returns the first capture group (or "").
   std::optional<std::string> wait_for_log(const std::string& pattern,
                                           std::chrono::milliseconds timeout,
@@ -111,8 +131,11 @@ class Mocap {
   }
 
  private:
-  std::string out_, err_;
-  pid_t pid_ = -1;
+  static std::vector<std::string> with(std::vector<std::string> env,
+                                       const std::vector<std::string>& extra) {
+    env.insert(env.end(), extra.begin(), extra.end());
+    return env;
+  }
 };
 
 }  // namespace mocap::test
