@@ -151,9 +151,8 @@ bool Matcher::match(std::span<const float, kBodyJoints * 3> body, std::vector<Ca
   // offset towards the front or back of the body, so the right candidates may lie nearer the
   // uncorrected keypoints. The union is re-scored.
   search(canonical, out);
-  std::vector<Candidate> raw;
-  search(query, raw);
-  for (const Candidate& c : raw)
+  search(query, uncorrected_);  // a member: no allocation per call once it has grown
+  for (const Candidate& c : uncorrected_)
     if (std::none_of(out.begin(), out.end(),
                      [&](const Candidate& o) { return o.projection == c.projection; }))
       out.push_back(c);

@@ -79,6 +79,7 @@ class Matcher {
   MatchOptions options_;
   std::optional<motion::BodyProportions> person_;
   std::optional<LayoutOffsets> layout_;
+  std::vector<Candidate> uncorrected_;  // match() with a layout: the uncorrected input's search
   struct Search;
   // Re-scores `out` against `query` (person_, layout_) and re-sorts it.
   void rescore(const posedb::PoseVector& query, std::vector<Candidate>& out) const;
