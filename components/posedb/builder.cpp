@@ -6,6 +6,7 @@
 #include <cmath>
 #include <ctime>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <mutex>
 #include <numeric>
@@ -417,6 +418,19 @@ DatabaseContents build_database_from_bodies(const std::vector<BodySequence>& seq
   std::vector<ClipFrames> clips = clips_from_bodies(sequences, options, progress, report);
   return assemble(clips, options, progress, report,
                   std::to_string(sequences.size()) + " sequence(s)", started);
+}
+
+std::vector<std::string> split_files(const std::string& folder, const std::string& split) {
+  std::ifstream list(std::filesystem::path(folder) / "splits.txt");
+  if (!list)
+    throw InputError(folder,
+                     "no splits.txt here: give the cmu31 folder of the shared data (--mocap)");
+  std::vector<std::string> files;
+  std::string which, file;
+  while (list >> which >> file) {
+    if (which == split) files.push_back((std::filesystem::path(folder) / file).string());
+  }
+  return files;
 }
 
 }  // namespace mocap::posedb

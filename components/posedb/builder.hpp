@@ -49,6 +49,10 @@ struct BuildReport {
 // Throws InputError for a path that does not exist.
 std::vector<std::string> collect_motion_files(const std::vector<std::string>& paths);
 
+// The files a folder's splits.txt ("train 01_01.bvh" lines) assigns to `split`, as paths in the
+// folder, in the list's order. Throws InputError naming the folder when it has no splits.txt.
+std::vector<std::string> split_files(const std::string& folder, const std::string& split);
+
 // Builds the database contents. Files that cannot be read are skipped and listed in `report`;
 // throws InputError when no file at all could be used.
 DatabaseContents build_database(const std::vector<std::string>& files, const BuildOptions& options,

@@ -19,6 +19,7 @@
 #include "fit/fit_evaluation.hpp"
 #include "fit/foot_contact.hpp"
 #include "fit/skeleton_fit.hpp"
+#include "posedb/builder.hpp"
 #include "posedb/database.hpp"
 #include "recon/matcher.hpp"
 #include "recon/temporal_selector.hpp"
@@ -27,16 +28,6 @@ namespace {
 
 using namespace mocap;
 using Clock = std::chrono::steady_clock;
-
-std::vector<std::string> heldout_files(const std::string& folder) {
-  std::ifstream list(std::filesystem::path(folder) / "splits.txt");
-  if (!list) throw InputError(folder, "no splits.txt: give the cmu31 folder with --mocap");
-  std::vector<std::string> files;
-  std::string which, file;
-  while (list >> which >> file)
-    if (which == "heldout") files.push_back((std::filesystem::path(folder) / file).string());
-  return files;
-}
 
 struct Row {
   eval::Scores pose;
@@ -117,7 +108,7 @@ int main(int argc, char** argv) {
   try {
     const posedb::Database db = posedb::Database::open(args.get("db"));
     const double fps = db.build_info().fps;
-    auto truth = eval::load_truth(heldout_files(args.get("mocap")), fps);
+    auto truth = eval::load_truth(posedb::split_files(args.get("mocap"), "heldout"), fps);
     if (const long n = args.integer("clips"); n > 0 && static_cast<std::size_t>(n) < truth.size())
       truth.resize(n);
     if (const long n = args.integer("max-frames"); n > 0)

@@ -25,17 +25,6 @@ double seconds_since(Clock::time_point t) {
   return std::chrono::duration<double>(Clock::now() - t).count();
 }
 
-std::vector<std::string> split_files(const std::string& folder, const std::string& split) {
-  std::vector<std::string> files;
-  std::ifstream list(std::filesystem::path(folder) / "splits.txt");
-  if (!list) throw InputError(folder, "no splits.txt: give the cmu31 folder of the shared data");
-  std::string which, file;
-  while (list >> which >> file) {
-    if (which == split) files.push_back((std::filesystem::path(folder) / file).string());
-  }
-  return files;
-}
-
 // Gaussian noise of `sigma` (a fraction of the 2D bounding-box height, which is 1 after
 // normalisation) on every joint, the root included; then normalised again as a detection would be.
 std::vector<float> with_noise(const float* row, float sigma, posedb::Scaling scaling,
@@ -76,7 +65,7 @@ int main(int argc, char** argv) {
 
     auto t = Clock::now();
     const auto db_contents =
-        posedb::build_database(split_files(folder, "train"), options, {}, report);
+        posedb::build_database(posedb::split_files(folder, "train"), options, {}, report);
     const double build_s = seconds_since(t);
     t = Clock::now();
     posedb::write_database(db_contents, args.get("out"));
@@ -104,8 +93,8 @@ int main(int argc, char** argv) {
     posedb::BuildReport heldout_report;
     posedb::BuildOptions heldout_options = options;
     heldout_options.clusters = 16;
-    const auto heldout =
-        posedb::build_database(split_files(folder, "heldout"), heldout_options, {}, heldout_report);
+    const auto heldout = posedb::build_database(posedb::split_files(folder, "heldout"),
+                                                heldout_options, {}, heldout_report);
     std::mt19937 rng(7);
     const std::size_t heldout_rows = heldout.projection_records.size();
     std::vector<std::vector<float>> clean, noisy;

@@ -12,6 +12,7 @@
 #include "cli_args.hpp"
 #include "core/input_error.hpp"
 #include "eval/virtual_protocol.hpp"
+#include "posedb/builder.hpp"
 #include "posedb/database.hpp"
 
 namespace {
@@ -33,17 +34,6 @@ double median(std::vector<double> v) {
   return v.empty() ? 0.0 : v[v.size() / 2];
 }
 
-std::vector<std::string> heldout_files(const std::string& folder) {
-  std::ifstream list(std::filesystem::path(folder) / "splits.txt");
-  if (!list) throw InputError(folder, "no splits.txt: give the cmu31 folder with --mocap");
-  std::vector<std::string> files;
-  std::string which, file;
-  while (list >> which >> file) {
-    if (which == "heldout") files.push_back((std::filesystem::path(folder) / file).string());
-  }
-  return files;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -58,7 +48,8 @@ int main(int argc, char** argv) {
   try {
     if (!args.has("db")) throw InputError("--db", "required");
     const posedb::Database db = posedb::Database::open(args.get("db"));
-    auto truth = eval::load_truth(heldout_files(args.get("mocap")), db.build_info().fps);
+    auto truth =
+        eval::load_truth(posedb::split_files(args.get("mocap"), "heldout"), db.build_info().fps);
     if (const long n = args.integer("clips"); n > 0 && static_cast<std::size_t>(n) < truth.size())
       truth.resize(n);
     std::vector<std::vector<recon::BodyXyc>> inputs;

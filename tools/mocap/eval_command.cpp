@@ -216,7 +216,7 @@ int virtual_protocol(int argc, char** argv) {
   const posedb::Database paper =
       open_paper_database(args.get("paper-db"), mocap, "mocap eval virtual");
 
-  auto truth = eval::load_truth(split_files(mocap, "heldout"), full.build_info().fps);
+  auto truth = eval::load_truth(posedb::split_files(mocap, "heldout"), full.build_info().fps);
   if (const long n = args.integer("clips"); n > 0 && static_cast<std::size_t>(n) < truth.size())
     truth.resize(n);
   const auto cameras = eval::default_cameras(args.has("quick"));

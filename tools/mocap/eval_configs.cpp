@@ -66,19 +66,6 @@ std::vector<Config> make_configs(const posedb::Database& full, const posedb::Dat
   return configs;
 }
 
-std::vector<std::string> split_files(const std::string& folder, const std::string& split) {
-  std::ifstream list(fs::path(folder) / "splits.txt");
-  if (!list)
-    throw InputError(folder,
-                     "no splits.txt here: give the cmu31 folder of the shared data with --mocap");
-  std::vector<std::string> files;
-  std::string which, file;
-  while (list >> which >> file) {
-    if (which == split) files.push_back((fs::path(folder) / file).string());
-  }
-  return files;
-}
-
 posedb::BuildOptions paper_build_options(const std::string& command) {
   posedb::BuildOptions options;
   options.views.heights_m = {1.5f};
@@ -103,7 +90,7 @@ posedb::Database open_paper_database(const std::string& given, const std::string
   std::cerr << "building the paper's yaw-only database from the train split of " << mocap << "\n";
   posedb::BuildReport report;
   const auto contents = posedb::build_database(
-      split_files(mocap, "train"),
+      posedb::split_files(mocap, "train"),
       paper_build_options(command + " (paper database: yaw-only views at 1.5 m)"), {}, report);
   return open_temporary_database(contents, "paper");
 }

@@ -38,9 +38,6 @@ struct Config {
 std::vector<Config> make_configs(const posedb::Database& full, const posedb::Database& paper,
                                  double fps);
 
-// The files of one split ("train", "heldout") listed in the cmu31 folder's splits.txt.
-std::vector<std::string> split_files(const std::string& folder, const std::string& split);
-
 // The paper's view set: the level 1.5 m camera only, at every yaw step.
 posedb::BuildOptions paper_build_options(const std::string& command);
 
