@@ -42,6 +42,7 @@ packages=(
   libzmq3-dev cppzmq-dev libyaml-cpp-dev                # graph framework: ZeroMQ edges, YAML graphs
   python3 python3-zmq python3-numpy                     # wire-format client; NumPy cross-check of the npz reader
   libopencv-dev                                         # images and video: overlay, video sources
+  libopencv-contrib-dev                                 # cv::aruco: ChArUco boards (mocap calibrate)
   opencv-doc                                            # vtest.avi, the demo's multi-person video
   blender                                               # a real BVH importer for the tests
   libaravis-dev aravis-tools libusb-1.0-0-dev           # GigE/USB3 Vision (aravis-0.8.pc needs libusb's .pc); fake camera

@@ -1,5 +1,6 @@
 #include "camera/camera_file.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <numbers>
@@ -43,7 +44,94 @@ cv::Mat read_matrix(const cv::FileStorage& fs, const std::string& path, const st
   return d;
 }
 
+void open_for_reading(cv::FileStorage& fs, const std::string& path) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) throw InputError(path, "no such file");
+  if (std::filesystem::file_size(path, ec) == 0 || ec) throw InputError(path, "empty file");
+  try {
+    if (!fs.open(path, cv::FileStorage::READ))
+      throw InputError(path, "not an OpenCV YAML/XML/JSON file");
+  } catch (const cv::Exception& e) {
+    throw InputError(path, "not a readable OpenCV YAML file (" + e.err + ")");
+  }
+}
+
+// Why a plane cannot be stored, or empty.
+std::string plane_problem(const GroundPlane& p) {
+  const auto& n = p.normal;
+  for (double v : n)
+    if (!std::isfinite(v)) return "'ground_normal' has a non-finite value";
+  const double length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+  if (length < 1e-9) return "'ground_normal' is the zero vector";
+  if (std::abs(length - 1.0) > 1e-3)
+    return "'ground_normal' must be a unit vector, its length is " + std::to_string(length);
+  if (!std::isfinite(p.offset)) return "'ground_offset' is not finite";
+  return {};
+}
+
 }  // namespace
+
+double camera_height_m(const GroundPlane& plane) { return plane.offset; }
+
+double camera_tilt_deg(const GroundPlane& plane) {
+  // The optical axis is +z; its component along "down" (-normal) is the sine of the tilt.
+  const double down = std::clamp(-plane.normal[2], -1.0, 1.0);
+  return std::asin(down) * 180.0 / std::numbers::pi;
+}
+
+std::optional<GroundPlane> read_ground_plane(const std::string& path) {
+  cv::FileStorage fs;
+  open_for_reading(fs, path);
+  const auto present = [&](const char* key) {
+    const cv::FileNode node = fs[key];
+    return !node.empty() && !node.isNone();
+  };
+  const bool has_normal = present("ground_normal");
+  const bool has_offset = present("ground_offset");
+  if (!has_normal && !has_offset) return std::nullopt;
+  if (!has_normal) throw InputError(path, "missing key 'ground_normal' (ground_offset is given)");
+  if (!has_offset) throw InputError(path, "missing key 'ground_offset' (ground_normal is given)");
+  GroundPlane plane;
+  try {
+    const cv::Mat n = read_matrix(fs, path, "ground_normal");
+    if ((n.rows != 1 && n.cols != 1) || n.total() != 3)
+      throw InputError(path, "key 'ground_normal' must be a 3x1 matrix, not " +
+                                 std::to_string(n.rows) + "x" + std::to_string(n.cols));
+    for (int i = 0; i < 3; ++i) plane.normal[i] = n.at<double>(i);
+    const cv::FileNode offset = fs["ground_offset"];
+    if (!offset.isReal() && !offset.isInt())
+      throw InputError(path, "key 'ground_offset' is not a number");
+    plane.offset = static_cast<double>(offset);
+  } catch (const cv::Exception& e) {
+    throw InputError(path, "malformed ground plane (" + e.err + ")");
+  }
+  if (const std::string problem = plane_problem(plane); !problem.empty())
+    throw InputError(path, "key " + problem);
+  return plane;
+}
+
+void write_ground_plane(const std::string& path, const GroundPlane& plane) {
+  if (const std::string problem = plane_problem(plane); !problem.empty())
+    throw std::invalid_argument("write_ground_plane: " + problem);
+  const CameraIntrinsics camera = read_camera_file(path);
+  double rms = -1.0;
+  {
+    cv::FileStorage fs;
+    open_for_reading(fs, path);
+    const cv::FileNode node = fs["avg_reprojection_error"];
+    if (node.isReal() || node.isInt()) rms = static_cast<double>(node);
+    if (!std::isfinite(rms) || rms < 0) rms = -1.0;
+  }
+  // Written beside the file, then renamed over it: a failed write leaves the old file intact.
+  const std::string temporary = path + ".tmp";
+  write_camera_file(temporary, camera, rms, plane);
+  std::error_code ec;
+  std::filesystem::rename(temporary, path, ec);
+  if (ec) {
+    std::filesystem::remove(temporary, ec);
+    throw InputError(path, "cannot replace the file");
+  }
+}
 
 CameraIntrinsics from_fov(int width, int height, double hfov_deg) {
   if (width <= 0 || height <= 0)
@@ -60,16 +148,8 @@ CameraIntrinsics from_fov(int width, int height, double hfov_deg) {
 }
 
 CameraIntrinsics read_camera_file(const std::string& path) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) throw InputError(path, "no such file");
-  if (std::filesystem::file_size(path, ec) == 0 || ec) throw InputError(path, "empty file");
   cv::FileStorage fs;
-  try {
-    if (!fs.open(path, cv::FileStorage::READ))
-      throw InputError(path, "not an OpenCV YAML/XML/JSON file");
-  } catch (const cv::Exception& e) {
-    throw InputError(path, "not a readable OpenCV YAML file (" + e.err + ")");
-  }
+  open_for_reading(fs, path);
   CameraIntrinsics c;
   try {
     c.width = read_size(fs, path, "image_width");
@@ -95,7 +175,11 @@ CameraIntrinsics read_camera_file(const std::string& path) {
   return c;
 }
 
-void write_camera_file(const std::string& path, const CameraIntrinsics& camera, double rms_px) {
+void write_camera_file(const std::string& path, const CameraIntrinsics& camera, double rms_px,
+                       const std::optional<GroundPlane>& ground) {
+  if (ground)
+    if (const std::string problem = plane_problem(*ground); !problem.empty())
+      throw std::invalid_argument("write_camera_file: " + problem);
   try {
     cv::FileStorage fs(path, cv::FileStorage::WRITE | cv::FileStorage::FORMAT_YAML);
     if (!fs.isOpened()) throw InputError(path, "cannot write");
@@ -111,6 +195,10 @@ void write_camera_file(const std::string& path, const CameraIntrinsics& camera, 
       D.at<double>(0, static_cast<int>(i)) = camera.distortion[i];
     fs << "distortion_coefficients" << D;
     if (rms_px >= 0) fs << "avg_reprojection_error" << rms_px;
+    if (ground) {
+      fs << "ground_normal" << cv::Mat(3, 1, CV_64F, const_cast<double*>(ground->normal.data()));
+      fs << "ground_offset" << ground->offset;
+    }
     fs.release();
   } catch (const cv::Exception& e) {
     throw InputError(path, "cannot write (" + e.err + ")");

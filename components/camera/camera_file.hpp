@@ -1,8 +1,10 @@
 #pragma once
 // Camera intrinsics and their files: OpenCV YAML as OpenCV's own calibration writes them
-// (camera_matrix, distortion_coefficients, image_width, image_height).
+// (camera_matrix, distortion_coefficients, image_width, image_height), optionally with the floor
+// as seen by the camera (ground_normal, ground_offset; `mocap calibrate ground`).
 
 #include <array>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -23,6 +25,15 @@ struct CameraIntrinsics {
   bool operator==(const CameraIntrinsics&) const = default;
 };
 
+// The floor in the camera frame (x right, y down, z forward, metres): the points x with
+// dot(normal, x) + offset = 0. `normal` is a unit vector pointing up, away from the floor, so the
+// camera centre (the origin) is `offset` metres above the floor (offset > 0 for a camera above it).
+struct GroundPlane {
+  std::array<double, 3> normal{};
+  double offset = 0.0;
+  bool operator==(const GroundPlane&) const = default;
+};
+
 // A pinhole camera without distortion whose horizontal field of view is `hfov_deg` (0 < hfov < 180)
 // with the principal point at the image centre, square pixels and five zero distortion
 // coefficients. Throws std::invalid_argument for
@@ -35,9 +46,27 @@ CameraIntrinsics from_fov(int width, int height, double hfov_deg);
 CameraIntrinsics read_camera_file(const std::string& path);
 
 // Writes a camera file (OpenCV YAML); an empty distortion is written as five zeros. `rms_px` >= 0
-// is written as avg_reprojection_error. Throws mocap::InputError naming the file when it cannot be
-// written.
+// is written as avg_reprojection_error, a ground plane as ground_normal and ground_offset. Throws
+// mocap::InputError naming the file when it cannot be written; std::invalid_argument for a ground
+// plane that read_ground_plane would reject.
 void write_camera_file(const std::string& path, const CameraIntrinsics& camera,
-                       double rms_px = -1.0);
+                       double rms_px = -1.0, const std::optional<GroundPlane>& ground = {});
+
+// Height of the camera centre above the floor in metres (= plane.offset).
+double camera_height_m(const GroundPlane& plane);
+// How far the optical axis points below the horizon, in degrees (negative: above it).
+double camera_tilt_deg(const GroundPlane& plane);
+
+// Reads the ground plane of a camera file: std::nullopt when the file has neither ground_normal
+// nor ground_offset. Throws mocap::InputError naming the file (and the key) for a missing,
+// empty or unparsable file, one of the two keys without the other, a normal that is not a 3-vector,
+// not finite, zero or not of unit length (within 1e-3), or an offset that is not a finite number.
+std::optional<GroundPlane> read_ground_plane(const std::string& path);
+
+// Rewrites the camera file `path` with its intrinsics (and avg_reprojection_error when present)
+// and the plane as ground_normal (3x1 matrix) and ground_offset (metres). Throws mocap::InputError
+// naming the file when it is not a valid camera file or cannot be written; std::invalid_argument
+// for a plane that is not finite or whose normal is not of unit length.
+void write_ground_plane(const std::string& path, const GroundPlane& plane);
 
 }  // namespace mocap::camera

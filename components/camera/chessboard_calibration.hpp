@@ -19,15 +19,17 @@ struct ChessboardOptions {
 
 struct SkippedView {
   std::string name;    // file, or "<video>#<frame>"
-  std::string reason;  // "unreadable image", "board not found", "size differs"
+  std::string reason;  // "unreadable image", "board not found", "size differs ..."
 };
 
-struct ChessboardCalibration {
+// What a calibration from board views found (chessboard here, ChArUco in charuco_calibration.hpp).
+struct BoardCalibration {
   CameraIntrinsics camera;
   double rms_px = 0.0;            // RMS reprojection error over all corners
   std::vector<std::string> used;  // views whose board was found
   std::vector<SkippedView> skipped;
 };
+using ChessboardCalibration = BoardCalibration;
 
 // Calibrates from image files (any format OpenCV reads) in the given order. Throws InputError when
 // fewer than options.min_views boards are found, naming the inputs; std::invalid_argument for a

@@ -1,6 +1,7 @@
 #include "camera/camera_file.hpp"
 
 #include <cmath>
+#include <filesystem>
 #include <numbers>
 #include <random>
 #include <stdexcept>
@@ -195,6 +196,144 @@ TEST(CameraFile, RandomBytesGiveAnErrorNamingTheFile) {
       EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
     }
   }
+}
+
+// The OpenCV sample file with a ground plane: the camera 1.5 m above the floor, tilted 30 degrees
+// down (normal (0, -cos 30, -sin 30)).
+std::string with_ground(const std::string& normal_data = "0., -8.6602540378443860e-01, -0.5",
+                        const std::string& offset = "1.5", int rows = 3, int cols = 1) {
+  return std::string(kOpenCvFile) +
+         "ground_normal: !!opencv-matrix\n   rows: " + std::to_string(rows) +
+         "\n   cols: " + std::to_string(cols) + "\n   dt: d\n   data: [ " + normal_data +
+         " ]\nground_offset: " + offset + "\n";
+}
+
+std::string ground_error_of(const std::string& path) {
+  try {
+    read_ground_plane(path);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+TEST(CameraFileGround, AbsentKeysGiveNoPlane) {
+  test::TempDir dir;
+  test::write_file(dir.file("cam.yml"), kOpenCvFile);
+  EXPECT_FALSE(read_ground_plane(dir.file("cam.yml")).has_value());
+}
+
+TEST(CameraFileGround, ReadsHeightAndTilt) {
+  test::TempDir dir;
+  test::write_file(dir.file("g.yml"), with_ground());
+  const std::optional<GroundPlane> plane = read_ground_plane(dir.file("g.yml"));
+  ASSERT_TRUE(plane.has_value());
+  EXPECT_DOUBLE_EQ(plane->offset, 1.5);
+  EXPECT_DOUBLE_EQ(camera_height_m(*plane), 1.5);
+  EXPECT_NEAR(camera_tilt_deg(*plane), 30.0, 1e-9);
+  EXPECT_NEAR(camera_tilt_deg({{0.0, -1.0, 0.0}, 2.0}), 0.0, 1e-12);   // level camera
+  EXPECT_NEAR(camera_tilt_deg({{0.0, 0.0, -1.0}, 2.0}), 90.0, 1e-12);  // looking straight down
+  // The intrinsics read as before.
+  EXPECT_DOUBLE_EQ(read_camera_file(dir.file("g.yml")).fx(), 5.3591573396163199e+02);
+}
+
+TEST(CameraFileGround, WriteKeepsIntrinsicsAndError) {
+  test::TempDir dir;
+  CameraIntrinsics c = from_fov(1280, 720, 70.0);
+  c.distortion = {-0.1, 0.02, 0.001, -0.0005, 0.003};
+  write_camera_file(dir.file("c.yml"), c, 0.375);
+  EXPECT_FALSE(read_ground_plane(dir.file("c.yml")).has_value());
+  const double s = std::sqrt(0.5);
+  const GroundPlane plane{{0.0, -s, -s}, 2.25};
+  write_ground_plane(dir.file("c.yml"), plane);
+  EXPECT_EQ(read_camera_file(dir.file("c.yml")), c);
+  EXPECT_EQ(read_ground_plane(dir.file("c.yml")), plane);
+  const std::string text = test::read_file(dir.file("c.yml"));
+  EXPECT_NE(text.find("avg_reprojection_error: 3.75"), std::string::npos) << text;
+  EXPECT_NE(text.find("ground_normal: !!opencv-matrix"), std::string::npos) << text;
+  EXPECT_NE(text.find("ground_offset: 2.25"), std::string::npos) << text;
+  // A second write replaces the plane; no temporary file is left behind.
+  const GroundPlane level{{0.0, -1.0, 0.0}, 1.0};
+  write_ground_plane(dir.file("c.yml"), level);
+  EXPECT_EQ(read_ground_plane(dir.file("c.yml")), level);
+  EXPECT_FALSE(std::filesystem::exists(dir.file("c.yml.tmp")));
+  // Planes that could not be read back are refused, and the file stays as it was.
+  EXPECT_THROW(write_ground_plane(dir.file("c.yml"), {{0.0, 0.0, 0.0}, 1.0}),
+               std::invalid_argument);
+  EXPECT_THROW(write_ground_plane(dir.file("c.yml"), {{0.0, -2.0, 0.0}, 1.0}),
+               std::invalid_argument);
+  EXPECT_THROW(write_ground_plane(dir.file("c.yml"), {{0.0, -1.0, 0.0}, std::nan("")}),
+               std::invalid_argument);
+  EXPECT_EQ(read_ground_plane(dir.file("c.yml")), level);
+  // Writing into a file that is not a camera file names it.
+  test::write_file(dir.file("junk.yml"), "%YAML:1.0\n---\nfoo: 1\n");
+  try {
+    write_ground_plane(dir.file("junk.yml"), level);
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("junk.yml: missing key 'image_width'"), std::string::npos)
+        << e.what();
+  }
+}
+
+TEST(CameraFileGround, MalformedPlanesNameFileAndKey) {
+  test::TempDir dir;
+  struct Case {
+    std::string name, text, expected;
+  };
+  const std::string nan = ".Nan";
+  const Case cases[] = {
+      {"shape2", with_ground("0., -1.", "1.5", 2, 1),
+       "key 'ground_normal' must be a 3x1 matrix, not 2x1"},
+      {"shape9", with_ground("1., 0., 0., 0., 1., 0., 0., 0., 1.", "1.5", 3, 3),
+       "key 'ground_normal' must be a 3x1 matrix, not 3x3"},
+      {"nan", with_ground("0., " + nan + ", 0.", "1.5"),
+       "key 'ground_normal' has a non-finite value"},
+      {"inf", with_ground("0., -1., 0.", ".Inf"), "key 'ground_offset' is not finite"},
+      {"zero", with_ground("0., 0., 0."), "key 'ground_normal' is the zero vector"},
+      {"long", with_ground("0., -2., 0."), "key 'ground_normal' must be a unit vector"},
+      {"text", with_ground("0., -1., 0.", "high"), "key 'ground_offset' is not a number"},
+      {"scalar", std::string(kOpenCvFile) + "ground_normal: 3\nground_offset: 1.5\n",
+       "key 'ground_normal'"},
+      {"no_offset",
+       std::string(kOpenCvFile) + "ground_normal: !!opencv-matrix\n   rows: 3\n"
+                                  "   cols: 1\n   dt: d\n   data: [ 0., -1., 0. ]\n",
+       "missing key 'ground_offset'"},
+      {"no_normal", std::string(kOpenCvFile) + "ground_offset: 1.5\n",
+       "missing key 'ground_normal'"},
+  };
+  for (const Case& c : cases) {
+    const std::string path = dir.file(c.name + ".yml");
+    test::write_file(path, c.text);
+    const std::string error = ground_error_of(path);
+    EXPECT_NE(error.find(path + ": "), std::string::npos) << c.name << ": " << error;
+    EXPECT_NE(error.find(c.expected), std::string::npos) << c.name << ": " << error;
+  }
+}
+
+TEST(CameraFileGround, TruncatedPlanesGiveAnErrorNamingTheFile) {
+  test::TempDir dir;
+  const std::string full = with_ground();
+  // Every cut from the start of ground_normal until the offset's value begins loses data.
+  const size_t first = full.find("ground_normal");
+  const size_t value = full.find("ground_offset: ") + 15;
+  for (size_t n = first + 1; n < value; n += 3) {
+    const std::string path = dir.file("t.yml");
+    test::write_file(path, full.substr(0, n));
+    try {
+      const auto plane = read_ground_plane(path);
+      ADD_FAILURE() << "no error for the first " << n
+                    << " bytes: " << full.substr(first, n - first);
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+    }
+  }
+  // Cut before the ground keys, the file simply has no plane.
+  test::write_file(dir.file("before.yml"), full.substr(0, first));
+  EXPECT_FALSE(read_ground_plane(dir.file("before.yml")).has_value());
+  // A missing file is named.
+  EXPECT_NE(ground_error_of(dir.file("nope.yml")).find("nope.yml: no such file"),
+            std::string::npos);
 }
 
 }  // namespace
