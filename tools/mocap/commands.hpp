@@ -13,5 +13,6 @@ int humaneva_eval_command(int argc, char** argv);
 int reconstruct_command(int argc, char** argv);
 int camera_command(int argc, char** argv);
 int calibrate_command(int argc, char** argv);
+int retarget_command(int argc, char** argv);
 
 }  // namespace mocap::cli

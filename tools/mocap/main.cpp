@@ -27,6 +27,8 @@ constexpr Command kCommands[] = {
      mocap::cli::camera_command},
     {"calibrate", "keypoint layout offsets (calibration/layouts/) and camera intrinsics",
      mocap::cli::calibrate_command},
+    {"retarget", "put a BVH motion onto another skeleton (rig given in its rest pose)",
+     mocap::cli::retarget_command},
 };
 
 void print_usage(std::ostream& out) {
