@@ -324,3 +324,56 @@ TEST(Retarget, BlenderImportsTheOutput) {
 
 }  // namespace
 }  // namespace mocap::motion
+
+namespace mocap::motion {
+namespace {
+
+// cgspeed's own Daz conversion of the same trials (cmu_daz/) is an independent retarget of the
+// same motion onto the same rig. It keeps the rig's rest bends (the Daz forearm points 17 degrees
+// forward of the elbow in rest, so its forearms differ from ours by about 20 degrees) and leaves
+// the collars still, but trunk, upper arms and legs should point about the same way.
+TEST(Retarget, AgreesWithCgspeedsDazConversionOfTheSameTrial) {
+  const char* trials[] = {"02_04", "05_01", "07_01", "08_01", "09_01"};
+  const std::string agreeing[] = {"abdomen", "lShldr", "rShldr", "lThigh",
+                                  "lShin",   "rThigh", "rShin"};
+  for (const char* trial : trials) {
+    const std::string daz_name = std::string("mocap/cmu_daz/") + trial + ".bvh";
+    const std::string cmu_name = std::string("mocap/cmu31/") + trial + ".bvh";
+    MOCAP_REQUIRE_SHARED(daz_name);
+    MOCAP_REQUIRE_SHARED(cmu_name);
+    const Clip reference = read_bvh(data(daz_name));
+    const Clip source = read_bvh(data(cmu_name));
+    RetargetOptions options;
+    options.target_source = data(daz_name);
+    const RetargetResult ours = retarget(source, reference.skeleton, options);
+    ASSERT_EQ(ours.clip.frame_count, reference.frame_count);
+    const PoseSequence a = to_poses(reference), b = to_poses(ours.clip);
+    GlobalPose ga, gb;
+    std::string line = std::string("[ retarget ] ") + trial +
+                       " ours vs cgspeed's Daz file, bone direction median/max deg:";
+    for (const NamedBone& bone : kDazBones) {
+      const int t0 = reference.skeleton.find(bone.target_from);
+      const int t1 = reference.skeleton.find(bone.target_to);
+      std::vector<double> e;
+      for (int f = 1; f < a.frame_count; ++f) {  // frame 0 is the inserted T-pose
+        forward_kinematics(a, f, ga);
+        forward_kinematics(b, f, gb);
+        e.push_back(
+            angle_degrees(ga.position[t1] - ga.position[t0], gb.position[t1] - gb.position[t0]));
+      }
+      const double m = median(e);
+      char text[96];
+      std::snprintf(text, sizeof text, " %s %.1f/%.1f", bone.target_from, m,
+                    *std::max_element(e.begin(), e.end()));
+      line += text;
+      if (std::find(std::begin(agreeing), std::end(agreeing), bone.target_from) !=
+          std::end(agreeing)) {
+        EXPECT_LT(m, 12.0) << trial << " " << bone.target_from;
+      }
+    }
+    std::printf("%s\n", line.c_str());
+  }
+}
+
+}  // namespace
+}  // namespace mocap::motion
