@@ -280,6 +280,9 @@ LiveFitter::~LiveFitter() = default;
 LiveFitter::LiveFitter(LiveFitter&&) noexcept = default;
 LiveFitter& LiveFitter::operator=(LiveFitter&&) noexcept = default;
 const BoneLengths& LiveFitter::bones() const { return state_->lengths; }
+void LiveFitter::set_ground(std::optional<GroundPlane> ground) {
+  state_->options.ground = ground;
+}
 const FitStats& LiveFitter::stats() const { return state_->stats; }
 
 std::optional<FittedFrame> LiveFitter::push(const FrameInput& frame) {

@@ -150,6 +150,8 @@ class LiveFitter {
 
   std::optional<FittedFrame> push(const FrameInput& frame);
   std::vector<FittedFrame> finish();  // the frames still held back by the lag
+  // The floor from now on (a ground estimated while running); nullopt: no ground term.
+  void set_ground(std::optional<GroundPlane> ground);
   const BoneLengths& bones() const;
   const FitStats& stats() const;
 
