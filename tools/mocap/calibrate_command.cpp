@@ -1,8 +1,11 @@
 // `mocap calibrate layout`: measures where a keypoint layout puts its joints relative to the
 // canonical body's joint centres (eval/layout_calibration.hpp) and writes the coefficients of the
 // correction (recon/layout_offsets.hpp) as calibration/layouts/<layout>.yaml.
-// `mocap calibrate intrinsics`: camera intrinsics from chessboard images or a video
-// (camera/chessboard_calibration.hpp), written as an OpenCV YAML camera file.
+// `mocap calibrate intrinsics`: camera intrinsics from chessboard or ChArUco images or a video
+// (camera/chessboard_calibration.hpp, camera/charuco_calibration.hpp), written as an OpenCV YAML
+// camera file.
+// `mocap calibrate ground`: the floor from one image of a board lying on it
+// (camera/ground_from_board.hpp), added to the camera file.
 
 #include <algorithm>
 #include <cctype>
@@ -16,8 +19,11 @@
 
 #include <glm/geometric.hpp>
 
+#include "camera/board.hpp"
 #include "camera/camera_file.hpp"
+#include "camera/charuco_calibration.hpp"
 #include "camera/chessboard_calibration.hpp"
+#include "camera/ground_from_board.hpp"
 #include "cli_args.hpp"
 #include "commands.hpp"
 #include "core/input_error.hpp"
@@ -264,8 +270,9 @@ bool is_image_file(const fs::path& p) {
   return false;
 }
 
-// "9x6" -> {9, 6}.
-std::pair<int, int> board_size(const std::string& text) {
+// "9x6" -> {9, 6}; `option` and `what` name the option and its meaning in the error.
+std::pair<int, int> grid_size(const std::string& text, const std::string& option,
+                              const std::string& what) {
   const auto x = text.find('x');
   try {
     if (x == std::string::npos) throw std::invalid_argument(text);
@@ -277,31 +284,73 @@ std::pair<int, int> board_size(const std::string& text) {
     if (columns < 2 || rows < 2 || columns > 100 || rows > 100) throw std::invalid_argument(text);
     return {columns, rows};
   } catch (const std::logic_error&) {
-    throw InputError("--board",
-                     "'" + text + "' is not COLUMNSxROWS inner corners (2..100 each), e.g. 9x6");
+    throw InputError(option, "'" + text + "' is not COLUMNSxROWS " + what + " (2..100 each)");
   }
 }
 
-int intrinsics_command(int argc, char** argv) {
-  Args args("mocap calibrate intrinsics IMAGES_OR_VIDEO... --board 9x6 --square MM --out FILE",
-            "Calibrates a camera's intrinsics from chessboard images (files, or folders of "
-            "them) or one video\n(every --step-th frame) with OpenCV, prints the views used and "
-            "skipped and the RMS reprojection\nerror, and writes an OpenCV YAML camera file "
-            "(camera_matrix, distortion_coefficients,\nimage_width, image_height).");
-  args.positional("inputs", "chessboard images, folders of images, or one video file", true)
-      .option("board", "CxR", "inner corners of the chessboard, columns x rows", "9x6")
+// The board options shared by `calibrate intrinsics` and `calibrate ground`.
+void board_options(Args& args) {
+  args.option("board", "KIND",
+              "chessboard or charuco; CxR alone (e.g. 9x6) is a chessboard with that many inner "
+              "corners",
+              "chessboard")
+      .option("corners", "CxR", "chessboard: inner corners, columns x rows", "9x6")
+      .option("squares", "CxR", "ChArUco: squares along x and y (as the board was created)", "5x7")
       .option("square", "MM", "side of one square in millimetres", "25")
-      .option("step", "N", "try every Nth frame of a video", "15")
+      .option("marker", "MM", "ChArUco: side of one marker in millimetres (required)")
+      .option("dictionary", "NAME",
+              "ChArUco: ArUco dictionary, e.g. DICT_4X4_50, DICT_5X5_100, DICT_6X6_250",
+              "DICT_4X4_50");
+}
+
+camera::BoardSpec board_from(const Args& args) {
+  camera::BoardSpec board;
+  const std::string kind = args.get("board");
+  std::string corners = args.get("corners");
+  if (kind == "charuco") {
+    board.kind = camera::BoardKind::charuco;
+    std::tie(board.columns, board.rows) = grid_size(args.get("squares"), "--squares", "squares");
+    if (!args.has("marker"))
+      throw InputError("--marker", "a ChArUco board needs its marker size in millimetres");
+    board.marker_mm = args.number("marker");
+    board.dictionary = args.get("dictionary");
+  } else {
+    if (kind != "chessboard") {
+      if (kind.find('x') == std::string::npos)
+        throw InputError("--board", "'" + kind + "' is not chessboard, charuco or CxR, e.g. 9x6");
+      corners = kind;
+    }
+    std::tie(board.columns, board.rows) =
+        grid_size(corners, kind == "chessboard" ? "--corners" : "--board", "inner corners");
+  }
+  board.square_mm = args.number("square");
+  if (!(board.square_mm > 0)) throw InputError("--square", "must be positive");
+  try {
+    camera::check_board(board);
+  } catch (const std::invalid_argument& e) {
+    throw InputError("--board", e.what());
+  }
+  return board;
+}
+
+int intrinsics_command(int argc, char** argv) {
+  Args args(
+      "mocap calibrate intrinsics IMAGES_OR_VIDEO... [--board chessboard|charuco ...] "
+      "--square MM --out FILE",
+      "Calibrates a camera's intrinsics from chessboard or ChArUco images (files, or "
+      "folders of them)\nor one video (every --step-th frame) with OpenCV, prints the "
+      "views used and skipped and the RMS\nreprojection error, and writes an OpenCV YAML "
+      "camera file (camera_matrix,\ndistortion_coefficients, image_width, image_height). "
+      "A ChArUco board may be partly hidden\nor cut by the image border.");
+  args.positional("inputs", "board images, folders of images, or one video file", true);
+  board_options(args);
+  args.option("step", "N", "try every Nth frame of a video", "15")
       .option("out", "FILE", "where to write the camera file (nothing written when absent)");
   int code = 0;
   if (!args.parse(argc, argv, code)) return code;
-  camera::ChessboardOptions options;
-  std::tie(options.inner_columns, options.inner_rows) = board_size(args.get("board"));
-  options.square_mm = args.number("square");
-  if (!(options.square_mm > 0)) throw InputError("--square", "must be positive");
+  const camera::BoardSpec board = board_from(args);
   const long step = args.integer("step");
   if (step < 1) throw InputError("--step", "must be at least 1");
-  options.video_step = static_cast<int>(step);
 
   std::vector<std::string> images;
   std::string video;
@@ -325,11 +374,23 @@ int intrinsics_command(int argc, char** argv) {
       throw InputError(input, "not an image file (a video must be the only input)");
     }
   }
-  const camera::ChessboardCalibration result =
-      video.empty() ? camera::calibrate_chessboard_images(images, options)
-                    : camera::calibrate_chessboard_video(video, options);
-  std::cout << "board " << options.inner_columns << "x" << options.inner_rows
-            << " inner corners, squares " << options.square_mm << " mm\n";
+  camera::BoardCalibration result;
+  if (board.kind == camera::BoardKind::chessboard) {
+    camera::ChessboardOptions options;
+    options.inner_columns = board.columns;
+    options.inner_rows = board.rows;
+    options.square_mm = board.square_mm;
+    options.video_step = static_cast<int>(step);
+    result = video.empty() ? camera::calibrate_chessboard_images(images, options)
+                           : camera::calibrate_chessboard_video(video, options);
+  } else {
+    camera::CharucoOptions options;
+    options.board = board;
+    options.video_step = static_cast<int>(step);
+    result = video.empty() ? camera::calibrate_charuco_images(images, options)
+                           : camera::calibrate_charuco_video(video, options);
+  }
+  std::cout << "board " << camera::describe(board) << "\n";
   std::cout << "used " << result.used.size() << " views:\n";
   for (const auto& name : result.used) std::cout << "  " << name << "\n";
   std::cout << "skipped " << result.skipped.size() << " views:\n";
@@ -350,14 +411,72 @@ int intrinsics_command(int argc, char** argv) {
   return 0;
 }
 
+int ground_command(int argc, char** argv) {
+  Args args(
+      "mocap calibrate ground --camera CAM.yml IMAGE [--board chessboard|charuco ...] "
+      "--square MM [--out FILE]",
+      "Finds the floor from one image of a calibration board lying flat on it: the "
+      "board's pose\n(solvePnP with the camera file's intrinsics and lens distortion) "
+      "gives its plane in the camera\nframe. Prints the camera's height above the floor "
+      "and its tilt (degrees of the optical axis\nbelow the horizon) and writes the plane "
+      "into the camera file (ground_normal, ground_offset).\nWithout a board, `mocap "
+      "reconstruct` estimates the ground from the feet of the people in view\nover time.");
+  args.positional("image", "an image of the board on the floor, taken by the calibrated camera");
+  args.option("camera", "FILE", "the camera file (OpenCV YAML, from `mocap calibrate intrinsics`)");
+  board_options(args);
+  args.option("thickness", "MM", "thickness of the board: the floor lies this far below it", "0")
+      .option("out", "FILE",
+              "write the camera file with the plane here instead of updating --camera");
+  int code = 0;
+  if (!args.parse(argc, argv, code)) return code;
+  if (!args.has("camera")) throw InputError("--camera", "the camera file is required");
+  const camera::BoardSpec board = board_from(args);
+  const double thickness = args.number("thickness");
+  if (!(thickness >= 0)) throw InputError("--thickness", "must be zero or positive");
+  const std::string camera_file = args.get("camera");
+  const camera::CameraIntrinsics cam = camera::read_camera_file(camera_file);
+  const std::string image = args.positionals().front();
+  const camera::FloorFromBoard floor =
+      camera::ground_from_board_image(image, cam, board, thickness);
+  const auto& n = floor.plane.normal;
+  std::cout << "board " << camera::describe(board) << ", thickness " << fixed(thickness, 1)
+            << " mm\n"
+            << "corners " << floor.corners << ", pose reprojection error " << fixed(floor.rms_px, 3)
+            << " px\n"
+            << "board origin in the camera frame " << fixed(floor.translation_m[0], 4) << " "
+            << fixed(floor.translation_m[1], 4) << " " << fixed(floor.translation_m[2], 4) << " m\n"
+            << "floor normal (up, camera frame) " << fixed(n[0], 5) << " " << fixed(n[1], 5) << " "
+            << fixed(n[2], 5) << "\n"
+            << "camera height above the floor " << fixed(camera::camera_height_m(floor.plane), 4)
+            << " m\n"
+            << "camera tilt " << fixed(camera::camera_tilt_deg(floor.plane), 2)
+            << " degrees below the horizon\n";
+  std::string target = camera_file;
+  if (args.has("out")) {
+    const fs::path out = args.get("out");
+    if (out.has_parent_path()) fs::create_directories(out.parent_path());
+    std::error_code ec;
+    if (!fs::equivalent(camera_file, out, ec))
+      fs::copy_file(camera_file, out, fs::copy_options::overwrite_existing);
+    target = out.string();
+  }
+  camera::write_ground_plane(target, floor.plane);
+  camera::read_ground_plane(target);  // what was written reads back
+  std::cout << "wrote " << target << "\n";
+  return 0;
+}
+
 }  // namespace
 
 int calibrate_command(int argc, char** argv) {
   static constexpr Subcommand kSubcommands[] = {
       {"layout", "fit where a keypoint layout puts its joints (calibration/layouts/)",
        layout_command},
-      {"intrinsics", "camera intrinsics from chessboard images or a video (OpenCV camera file)",
+      {"intrinsics",
+       "camera intrinsics from chessboard or ChArUco images or a video (OpenCV camera file)",
        intrinsics_command},
+      {"ground", "the floor from an image of a board lying on it (added to the camera file)",
+       ground_command},
   };
   return run_subcommand("calibrate", kSubcommands, argc, argv);
 }
