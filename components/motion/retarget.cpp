@@ -237,6 +237,31 @@ std::string trim_comment(const std::string& line) {
   return hash == std::string::npos ? line : line.substr(0, hash);
 }
 
+// Says when a rig's rest pose is not standing upright with its left side on +X: the joints
+// without a single bone (pelvis, chest, head, hands, feet) take the source's world orientation
+// change as is, which needs both rest poses in that convention.
+void check_rest_convention(const Skeleton& s, const std::array<int, kRoles>& roles,
+                           const std::string& name, std::vector<std::string>& warnings) {
+  const std::vector<glm::vec3> p = rest_positions(s);
+  auto at = [&](Role r) { return roles[static_cast<int>(r)]; };
+  const int pelvis = at(Role::pelvis), neck = at(Role::neck);
+  const int left = at(Role::left_thigh), right = at(Role::right_thigh);
+  auto off = [](glm::vec3 v, glm::vec3 axis) {
+    return glm::length(v) < 1e-6f ? 0.0f
+                                  : glm::degrees(std::acos(std::clamp(
+                                        glm::dot(glm::normalize(v), axis), -1.0f, 1.0f)));
+  };
+  if (pelvis >= 0 && neck >= 0 && off(p[neck] - p[pelvis], {0, 1, 0}) > 30.0f)
+    warnings.push_back(name +
+                       ": in the rest pose (zero rotations) the spine does not point up "
+                       "(+Y); pelvis, chest, head, hand and foot orientations will be off");
+  if (left >= 0 && right >= 0 && off(p[left] - p[right], {1, 0, 0}) > 30.0f)
+    warnings.push_back(name +
+                       ": in the rest pose (zero rotations) the left hip is not on +X of "
+                       "the right one; pelvis, chest, head, hand and foot orientations "
+                       "will be off");
+}
+
 }  // namespace
 
 JointMap read_joint_map(const std::string& path) {
@@ -311,6 +336,8 @@ RetargetResult retarget(const Clip& source, const Skeleton& target,
     have_roles = false;
   }
   if (have_roles) {
+    check_rest_convention(src, src_roles, source.source, result.warnings);
+    check_rest_convention(target, tgt_roles, target_name, result.warnings);
     for (int r = 0; r < kRoles; ++r) {
       if (src_roles[r] >= 0 && tgt_roles[r] >= 0 && source_of[tgt_roles[r]] < 0) {
         source_of[tgt_roles[r]] = src_roles[r];

@@ -71,6 +71,9 @@ struct RetargetResult {
   bool scale_is_auto = true;
   float source_hip_height = 0.0f;  // rest pose, source units (0 when not measurable)
   float target_hip_height = 0.0f;  // rest pose, target units
+  // Rest poses that break the method's assumption (Y up, left on +X, standing): e.g. Bandai,
+  // whose zero-rotation pose has every bone along its local +X.
+  std::vector<std::string> warnings;
 };
 
 // Retargets `source` onto `target`. Throws InputError (naming the rig or the map file) when too

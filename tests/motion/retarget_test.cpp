@@ -98,6 +98,7 @@ TEST_P(RetargetOntoDaz, BoneDirectionsMatchTheSourceEveryFrameAndTheRigKeepsItsB
   }
   EXPECT_EQ(out.channel_count, 132);
   EXPECT_EQ(result.clip.frame_count, source.frame_count);
+  EXPECT_TRUE(result.warnings.empty()) << result.warnings.front();
   EXPECT_EQ(result.matches.size(), 21u);  // 15 body joints + spine, chest, collars, index fingers
 
   // Forward kinematics of both: each bone points the same way in every frame.
@@ -269,6 +270,20 @@ TEST(Retarget, GarbageTruncatedOrEmptyRigsAreErrorsNamingTheFile) {
   const std::string hierarchy = daz.substr(0, daz.find("MOTION"));
   test::write_file(dir.file("bare.bvh"), hierarchy);
   EXPECT_EQ(read_rig(dir.file("bare.bvh")).joint_count(), read_rig(data(kDazRig)).joint_count());
+}
+
+// Bandai's zero-rotation pose has every bone along its local +X: not a standing rest pose, and
+// the result says so.
+TEST(Retarget, ARestPoseThatIsNotStandingIsReported) {
+  const std::string bandai = "mocap/bandai/dataset-1/dataset-1_bye_feminine_001.bvh";
+  MOCAP_REQUIRE_SHARED("mocap/cmu31/07_01.bvh");
+  MOCAP_REQUIRE_SHARED(bandai);
+  RetargetOptions options;
+  options.target_source = data(bandai);
+  const RetargetResult result =
+      retarget(read_bvh(data("mocap/cmu31/07_01.bvh")), read_rig(data(bandai)), options);
+  ASSERT_FALSE(result.warnings.empty());
+  EXPECT_NE(result.warnings.front().find(data(bandai)), std::string::npos);
 }
 
 TEST(Retarget, ExplicitScaleMovesTheRootByThatFactor) {

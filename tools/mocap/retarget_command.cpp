@@ -69,9 +69,11 @@ int retarget_command(int argc, char** argv) {
   report << std::fixed << std::setprecision(3);
   int rig_joints = 0;
   for (const auto& j : rig.joints) rig_joints += j.end_site ? 0 : 1;
-  report << "retargeted " << in_path << " (" << source.skeleton.joint_count() << " points, "
-         << source.frame_count << " frames at " << std::setprecision(2) << source.fps()
-         << " fps) onto " << rig_path << " -> " << args.get("out") << "\n";
+  int source_joints = 0;
+  for (const auto& j : source.skeleton.joints) source_joints += j.end_site ? 0 : 1;
+  report << "retargeted " << in_path << " (" << source_joints << " joints, " << source.frame_count
+         << " frames at " << std::setprecision(2) << source.fps() << " fps) onto " << rig_path
+         << " -> " << args.get("out") << "\n";
   report << "  joints mapped: " << result.matches.size() << " of " << rig_joints << "\n";
   for (const motion::JointMatch& m : result.matches) {
     report << "    " << std::left << std::setw(16) << rig.joints[m.target].name << " <- "
@@ -89,6 +91,7 @@ int retarget_command(int argc, char** argv) {
          << " bones x " << source.frame_count << " frames): median " << percentile(errors, 0.5)
          << " deg, max "
          << (errors.empty() ? 0.0f : *std::max_element(errors.begin(), errors.end())) << " deg\n";
+  for (const std::string& warning : result.warnings) report << "  warning: " << warning << "\n";
   std::cout << report.str();
   return 0;
 }
