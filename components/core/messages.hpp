@@ -80,16 +80,32 @@ inline std::array<glm::quat, kBodyJoints> identity_rotations() {
 
 struct Person3D {
   int id = -1;
-  // Metres, camera coordinates (x right, y down, z forward), indexed by mocap::Joint.
+  // Metres, camera coordinates (x right, y down, z forward), indexed by mocap::Joint; relative to
+  // the root (mid-hips), which sits at the origin.
   std::array<glm::vec3, kBodyJoints> positions{};
   std::array<glm::quat, kBodyJoints> rotations = identity_rotations();  // local joint rotations
+  // rotation: the matched database body turned into the camera frame. translation: where the root
+  // is in the camera frame (metres) once it is estimated (`placed`, the fitting), else zero.
   RigidTransform root;
+  bool placed = false;
   Provenance provenance;
+  // The 15 body joints of the 2D person this pose was reconstructed from (image pixels, as
+  // detected: not undistorted); confidence 0 where missing or unknown.
+  std::array<Keypoint2D, kBodyJoints> keypoints{};
+};
+
+// The floor in the camera frame: points x with dot(normal, x) + offset = 0, `normal` a unit vector
+// pointing up (away from the floor), so the camera centre is `offset` metres above the floor.
+struct GroundPlane {
+  glm::vec3 normal{0.0f, -1.0f, 0.0f};
+  float offset = 0.0f;
 };
 
 struct People3D : Message {
   static constexpr std::string_view kTypeName = "People3D";
   std::vector<Person3D> people;
+  bool has_ground = false;  // the floor is known (calibrated or estimated from the feet)
+  GroundPlane ground;
 };
 
 // A person prepared for the pose database (the scaler fills `normalized`) and matched against

@@ -128,8 +128,11 @@ std::vector<Frame> encode_people_2d(const People2D& m) {
 }
 
 std::vector<Frame> encode_people_3d(const People3D& m) {
-  Writer meta, positions, rotations, clips;
+  Writer meta, positions, rotations, clips, placement;
   meta.put<std::uint32_t>(static_cast<std::uint32_t>(m.people.size()));
+  placement.put<std::uint32_t>(m.has_ground ? 1u : 0u);
+  for (int i = 0; i < 3; ++i) placement.put<float>(m.ground.normal[i]);
+  placement.put<float>(m.ground.offset);
   for (const Person3D& p : m.people) {
     meta.put<std::int32_t>(p.id);
     meta.put<std::int32_t>(p.provenance.view);
@@ -146,12 +149,19 @@ std::vector<Frame> encode_people_3d(const People3D& m) {
     if (p.provenance.clip.size() > 0xFFFF) throw WireError("People3D: clip name too long");
     clips.put<std::uint16_t>(static_cast<std::uint16_t>(p.provenance.clip.size()));
     clips.put_bytes(p.provenance.clip.data(), p.provenance.clip.size());
+    placement.put<std::uint32_t>(p.placed ? 1u : 0u);
+    for (const Keypoint2D& k : p.keypoints) {
+      placement.put<float>(k.x);
+      placement.put<float>(k.y);
+      placement.put<float>(k.confidence);
+    }
   }
   std::vector<Frame> frames;
   frames.push_back(std::move(meta).frame());
   frames.push_back(std::move(positions).frame());
   frames.push_back(std::move(rotations).frame());
   frames.push_back(std::move(clips).frame());
+  frames.push_back(std::move(placement).frame());
   return frames;
 }
 
@@ -266,6 +276,11 @@ Packet decode_people_3d(const Header& header, std::span<const Frame> payload) {
   expect_size(payload[2], std::size_t{count} * kBodyJoints * 16, "People3D rotations");
   Reader positions(payload[1], "People3D positions"), rotations(payload[2], "People3D rotations");
   Reader clips(payload[3], "People3D provenance");
+  expect_size(payload[4], 20 + std::size_t{count} * (4 + kBodyJoints * 12), "People3D placement");
+  Reader placement(payload[4], "People3D placement");
+  m->has_ground = placement.get<std::uint32_t>() != 0;
+  for (int i = 0; i < 3; ++i) m->ground.normal[i] = placement.get<float>();
+  m->ground.offset = placement.get<float>();
   m->people.resize(count);
   for (Person3D& p : m->people) {
     p.id = meta.get<std::int32_t>();
@@ -284,8 +299,12 @@ Packet decode_people_3d(const Header& header, std::span<const Frame> payload) {
       q = glm::quat(qw, qx, qy, qz);
     }
     p.provenance.clip = clips.get_string(clips.get<std::uint16_t>());
+    p.placed = placement.get<std::uint32_t>() != 0;
+    for (Keypoint2D& k : p.keypoints)
+      k = {placement.get<float>(), placement.get<float>(), placement.get<float>()};
   }
   clips.expect_end();
+  placement.expect_end();
   return Packet::of<People3D>(std::move(m));
 }
 
@@ -353,7 +372,7 @@ constexpr TypeInfo kTypes[] = {
     {TypeCode::end_of_stream, EndOfStream::kTypeName, 0},
     {TypeCode::video_frame, VideoFrame::kTypeName, 2},
     {TypeCode::people_2d, People2D::kTypeName, 2},
-    {TypeCode::people_3d, People3D::kTypeName, 4},
+    {TypeCode::people_3d, People3D::kTypeName, 5},
     {TypeCode::graph_stats, GraphStats::kTypeName, 1},
     {TypeCode::pose_matches, PoseMatches::kTypeName, 4},
 };

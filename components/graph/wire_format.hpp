@@ -1,5 +1,5 @@
 #pragma once
-// The wire format between processes, version 1 (docs/wire-format.md): one message is a ZeroMQ
+// The wire format between processes, version 2 (docs/wire-format.md): one message is a ZeroMQ
 // multipart message made of a fixed header frame and type-specific payload frames; image pixels
 // are a frame of their own so they are sent and received without a copy. This file knows
 // nothing of ZeroMQ: frames are byte ranges with an owner that keeps them alive.
@@ -17,7 +17,7 @@
 
 namespace mocap::graph::wire {
 
-inline constexpr std::uint16_t kVersion = 1;
+inline constexpr std::uint16_t kVersion = 2;
 inline constexpr char kMagic[4] = {'M', 'O', 'C', 'P'};
 inline constexpr std::size_t kHeaderBytes = 44;  // without the stream id
 inline constexpr std::size_t kMaxFrames = 8;     // no message type has more payload frames

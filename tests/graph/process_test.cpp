@@ -239,7 +239,7 @@ TEST(Process, GarbageSentToARunningGraphIsRejectedWithAMessage) {
   zmq_setsockopt(raw, ZMQ_LINGER, &linger, sizeof linger);
   ASSERT_EQ(zmq_connect(raw, ("ipc://" + dir.file("people")).c_str()), 0);
   for (const char* junk :
-       {"hello", "MOCP\x02\x00garbage-with-a-plausible-start-but-version-2-and-too-short"}) {
+       {"hello", "MOCP\x03\x00garbage-with-a-plausible-start-but-version-3-and-too-short"}) {
     zmq_send(raw, junk, std::strlen(junk), 0);
   }
   zmq_close(raw);

@@ -26,7 +26,7 @@ BYTES_PER_PIXEL = {1: 1, 2: 3, 3: 3, 4: 4, 5: 4}
 def decode(parts):
     magic, version, kind, seq, capture_ns, frame, send_ns, stream_len, count = HEADER.unpack_from(parts[0])
     assert magic == b"MOCP", magic
-    assert version == 1, version
+    assert version == 2, version
     assert len(parts[0]) == HEADER.size + stream_len
     assert len(parts) == count + 1
     message = {"type": kind, "seq": seq, "frame": frame, "capture_ns": capture_ns,

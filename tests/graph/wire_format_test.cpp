@@ -45,7 +45,11 @@ std::shared_ptr<People3D> people_3d() {
   person.rotations[2] = glm::quat(0.5f, 0.5f, -0.5f, 0.5f);
   person.root = {glm::quat(0.0f, 1.0f, 0.0f, 0.0f), {1, 2, 3}};
   person.provenance = {"cmu/02_01", 120, 7};
+  person.placed = true;
+  person.keypoints[3] = {640.5f, 360.25f, 0.75f};
   m->people = {person, Person3D{}};
+  m->has_ground = true;
+  m->ground = {{0.0f, -0.96f, 0.28f}, 1.6f};
   return m;
 }
 
@@ -101,7 +105,15 @@ TEST(WireFormat, People3DRoundTrips) {
   EXPECT_EQ(p.provenance.clip, "cmu/02_01");
   EXPECT_EQ(p.provenance.frame, 120);
   EXPECT_EQ(p.provenance.view, 7);
+  EXPECT_TRUE(p.placed);
+  EXPECT_EQ(p.keypoints[3].x, 640.5f);
+  EXPECT_EQ(p.keypoints[3].y, 360.25f);
+  EXPECT_EQ(p.keypoints[3].confidence, 0.75f);
   EXPECT_EQ(m.people[1].provenance.clip, "");
+  EXPECT_FALSE(m.people[1].placed);
+  EXPECT_TRUE(m.has_ground);
+  EXPECT_EQ(m.ground.normal, glm::vec3(0.0f, -0.96f, 0.28f));
+  EXPECT_EQ(m.ground.offset, 1.6f);
 }
 
 TEST(WireFormat, PoseMatchesRoundTrips) {
@@ -192,9 +204,11 @@ std::vector<Frame> patched(std::vector<Frame> frames, std::size_t frame, std::si
 TEST(WireFormat, MalformedMessagesAreRejectedWithAReason) {
   const auto valid = as_received(wire::encode(Packet::of<People2D>(people_2d()), 0));
   EXPECT_NE(rejection({}).find("empty"), std::string::npos);
-  const std::uint16_t version = 2;
-  EXPECT_NE(rejection(patched(valid, 0, 4, &version, 2)).find("version 2 is not supported"),
-            std::string::npos);
+  for (const std::uint16_t version : {1, 3}) {  // 1: People3D had no placement frame
+    EXPECT_NE(rejection(patched(valid, 0, 4, &version, 2))
+                  .find("version " + std::to_string(version) + " is not supported"),
+              std::string::npos);
+  }
   EXPECT_NE(rejection(patched(valid, 0, 0, "XXXX", 4)).find("bad magic"), std::string::npos);
   const std::uint16_t type = 77;
   EXPECT_NE(rejection(patched(valid, 0, 6, &type, 2)).find("unknown message type"),

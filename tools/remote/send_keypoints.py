@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Sends 2D keypoints to a mocap graph (node source.remote_keypoints) over ZeroMQ PUSH, encoded in
-the mocap wire format version 1 (docs/wire-format.md) with nothing but `struct` and `zmq`: a model
+the mocap wire format version 2 (docs/wire-format.md) with nothing but `struct` and `zmq`: a model
 of what a detector in Python (or on a GPU machine) does. The keypoints come from a folder of
 OpenPose *_keypoints.json files; replace read_openpose_folder() with your detector.
 
@@ -25,7 +25,7 @@ try:
 except ImportError:
     sys.exit("send_keypoints.py: python3-zmq is not installed (apt-get install python3-zmq)")
 
-MAGIC, VERSION = b"MOCP", 1
+MAGIC, VERSION = b"MOCP", 2
 HEADER = struct.Struct("<4sHHQqqqHH")  # 44 bytes, then the stream id
 END_OF_STREAM, PEOPLE_2D = 0, 2
 LAYOUTS = {"COCO-17": (0, 17), "BODY_25": (1, 25), "BODY_25B": (2, 25), "COCO-18": (3, 18),

@@ -91,9 +91,10 @@ class TemporalSelectorNode : public Node {
   void process(Context& ctx) override {
     const auto& in = ctx.input<PoseMatches>("in");
     const std::int64_t t = next_frame_++;
-    pending_.push_back({ctx.header(), {}, {}, {}});
+    pending_.push_back({ctx.header(), {}, {}, {}, {}});
     for (const PersonMatch& person : in.people) {
       if (person.id < 0) continue;  // untracked: no history to choose with
+      pending_.back().keypoints[person.id] = person.body;
       const Keypoint2D& root = person.body[index(Joint::root)];
       if (lens_) {
         const auto [x, y] = camera::undistort_pixel(*lens_, root.x, root.y);
@@ -145,6 +146,7 @@ class TemporalSelectorNode : public Node {
     std::vector<Person3D> people;
     std::map<int, glm::vec2> root_pixel;      // of each person in this frame's input
     std::map<int, posedb::PoseVector> query;  // each person's normalised 2D pose
+    std::map<int, std::array<Keypoint2D, kBodyJoints>> keypoints;  // each person's 2D body
   };
 
   void start(Track& track, std::int64_t t) {
@@ -195,6 +197,8 @@ class TemporalSelectorNode : public Node {
       recon::turn_onto_ray(turned, camera_, root->second);
     }
     pending.people.push_back(to_person(id, turned, *db_));
+    if (const auto body = pending.keypoints.find(id); body != pending.keypoints.end())
+      pending.people.back().keypoints = body->second;
   }
 
   // Sends every pending frame up to and including `last`, in order.
