@@ -19,6 +19,7 @@
 #include "fit/fit_evaluation.hpp"
 #include "fit/foot_contact.hpp"
 #include "fit/skeleton_fit.hpp"
+#include "fit/view_fit.hpp"
 #include "posedb/builder.hpp"
 #include "posedb/database.hpp"
 #include "recon/matcher.hpp"
@@ -43,21 +44,6 @@ struct Row {
 
 double seconds_since(Clock::time_point t) {
   return std::chrono::duration<double>(Clock::now() - t).count();
-}
-
-// The retrieval's poses placed by the closed-form translation (what the fit starts from).
-std::vector<fit::FittedFrame> placed_retrieval(std::span<const fit::FrameInput> inputs,
-                                               const recon::Pinhole& camera) {
-  std::vector<fit::FittedFrame> out(inputs.size());
-  for (std::size_t t = 0; t < inputs.size(); ++t) {
-    if (!inputs[t].retrieved_valid) continue;
-    const auto tr = fit::initial_translation(inputs[t].retrieved, inputs[t].keypoints, camera);
-    if (!tr) continue;
-    out[t].valid = true;
-    for (int j = 0; j < kBodyJoints; ++j)
-      out[t].joints[j] = inputs[t].retrieved[j] + glm::vec3(*tr);
-  }
-  return out;
 }
 
 void print_row(const std::string& name, const std::string& condition, const Row& r) {
@@ -188,7 +174,7 @@ int main(int argc, char** argv) {
           {
             Row r;
             r.pose = eval::score(poses, rendered.truth_camera);
-            r.placement = placement(placed_retrieval(inputs, pinhole));
+            r.placement = placement(fit::placed_retrieval(inputs, pinhole));
             rows[{methods[1], cond}].add(r);
           }
           {

@@ -10,6 +10,9 @@ int graph_command(int argc, char** argv);
 int eval_command(int argc, char** argv);
 // `mocap eval humaneva`, reached through eval_command.
 int humaneva_eval_command(int argc, char** argv);
+// `mocap eval humaneva-fit` and `mocap eval crossview`, reached through eval_command.
+int humaneva_fit_command(int argc, char** argv);
+int crossview_eval_command(int argc, char** argv);
 int reconstruct_command(int argc, char** argv);
 int camera_command(int argc, char** argv);
 int calibrate_command(int argc, char** argv);

@@ -314,6 +314,10 @@ int eval_command(int argc, char** argv) {
       {"virtual", "the paper's virtual-video protocol on held-out CMU subjects", virtual_protocol},
       {"humaneva", "HumanEva-I Validate from ground-truth 2D, CMU and HumanEva databases",
        humaneva_eval_command},
+      {"humaneva-fit", "HumanEva-I Validate with its cameras, before and after skeleton fitting",
+       humaneva_fit_command},
+      {"crossview", "cross-view consistency (paper 5.3): Pose2Sim 4 views, HumanEva-I 3 views",
+       crossview_eval_command},
   };
   return run_subcommand("eval", kSubcommands, argc, argv);
 }
