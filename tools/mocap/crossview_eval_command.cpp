@@ -302,7 +302,8 @@ int crossview_eval_command(int argc, char** argv) {
     }
     if (group_count == 0) continue;
     std::cout << "### " << dataset << ": " << group_count << " multi-view sequence(s), " << frames
-              << " view-frames at " << fps << " fps\n\n"
+              << " view-frames at " << std::defaultfloat << std::setprecision(6) << fps
+              << " fps\n\n"
               << "Mean per-joint distance between two views' reconstructions of the same "
                  "instant, cm (world: camera rotations only; yaw-aligned: the rotation about the "
                  "vertical removed, EVALUATION.md).\n\n"
@@ -312,9 +313,13 @@ int crossview_eval_command(int argc, char** argv) {
     json jd = json::object();
     auto row = [&](const std::string& name, double angle, double count,
                    const std::array<double, 5>& cm) {
-      std::cout << "| " << name << " | " << std::fixed << std::setprecision(0) << angle << " | "
-                << count << " | " << std::setprecision(1) << cm[0] << " | " << cm[1] << " | "
-                << cm[2] << " | " << cm[3] << " | " << cm[4] << " |\n";
+      std::cout << "| " << name << " | " << std::fixed << std::setprecision(0);
+      if (std::isfinite(angle))
+        std::cout << angle;
+      else
+        std::cout << "-";
+      std::cout << " | " << count << " | " << std::setprecision(1) << cm[0] << " | " << cm[1]
+                << " | " << cm[2] << " | " << cm[3] << " | " << cm[4] << " |\n";
     };
     for (std::size_t p = 0; p < names.size(); ++p) {
       const std::array<double, 5> cm = {totals[0][0][p].mean_cm(), totals[1][0][p].mean_cm(),
