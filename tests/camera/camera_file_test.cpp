@@ -321,7 +321,7 @@ TEST(CameraFileGround, TruncatedPlanesGiveAnErrorNamingTheFile) {
     const std::string path = dir.file("t.yml");
     test::write_file(path, full.substr(0, n));
     try {
-      const auto plane = read_ground_plane(path);
+      read_ground_plane(path);
       ADD_FAILURE() << "no error for the first " << n
                     << " bytes: " << full.substr(first, n - first);
     } catch (const InputError& e) {
@@ -334,6 +334,21 @@ TEST(CameraFileGround, TruncatedPlanesGiveAnErrorNamingTheFile) {
   // A missing file is named.
   EXPECT_NE(ground_error_of(dir.file("nope.yml")).find("nope.yml: no such file"),
             std::string::npos);
+  // Random bytes after a valid camera file: an error naming the file or no plane, never a crash.
+  std::mt19937 rng(11);
+  for (int trial = 0; trial < 50; ++trial) {
+    std::string bytes = full.substr(0, first + rng() % (full.size() - first));
+    for (int i = 0; i < 40; ++i) bytes += static_cast<char>(rng() % 256);
+    std::string name = std::to_string(trial);
+    name += "r.yml";
+    const std::string path = dir.file(name);
+    test::write_file(path, bytes);
+    try {
+      read_ground_plane(path);
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+    }
+  }
 }
 
 }  // namespace
