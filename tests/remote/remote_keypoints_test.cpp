@@ -117,7 +117,7 @@ std::vector<std::vector<std::string>> garbage() {
   bad.push_back({valid[0].substr(0, 20)});                                       // truncated header
   bad.push_back({valid[0], valid[1], valid[2].substr(0, valid[2].size() - 5)});  // short keypoints
   auto version = valid;
-  version[0][4] = 2;  // wire format version 2
+  version[0][4] = 3;  // wire format version 3
   bad.push_back(version);
   auto oversized = valid;
   const std::uint32_t people = 5000;  // beyond the 4096 limit
