@@ -4,8 +4,11 @@
 //           (clip = index into the database's clips, offset = frame within the clip)
 // Outputs per script frame: People3D (positions = the database body turned by the view, camera
 // axes), People2D (the same body drawn orthographically, BODY_25 layout, boxes side by side) and a
-// VideoFrame (a flat colour). `skip_2d` lists frames whose People2D is not sent; `repeat` plays
-// the script again and again until the graph is stopped (for kill tests).
+// VideoFrame (a flat colour). With `depth_m` > 0 every person stands that far in front of a
+// 640x480 pinhole camera (fx = fy = 600, principal point at the centre), person k at x = 1.2 k m,
+// and their People3D carry the exact projection of their joints as keypoints. `skip_2d` lists
+// frames whose People2D is not sent; `repeat` plays the script again and again until the graph is
+// stopped (for kill tests).
 
 #include <sstream>
 
@@ -71,6 +74,8 @@ class PeopleScriptSource : public Node {
     c.param<std::string>("skip_2d", "", "frames (comma-separated) sent without People2D");
     c.param<bool>("repeat", false, "play the script until stopped");
     c.param<double>("interval_ms", 0.0, "pause between frames", {0, 10000});
+    c.param<double>("depth_m", 0.0, "place people in front of a pinhole camera (0: no keypoints)",
+                    {0, 100});
   }
 
   void open(Context& ctx) override {
@@ -81,6 +86,7 @@ class PeopleScriptSource : public Node {
       if (!f.empty()) skip_2d_.push_back(std::stoll(f));
     }
     repeat_ = ctx.param<bool>("repeat");
+    depth_m_ = ctx.param<float>("depth_m");
     interval_ =
         std::chrono::nanoseconds(static_cast<std::int64_t>(ctx.param<double>("interval_ms") * 1e6));
   }
@@ -98,6 +104,7 @@ class PeopleScriptSource : public Node {
     p2.layout = LayoutId::body25;
     for (std::size_t slot = 0; slot < people.size(); ++slot) {
       p3.people.push_back(person3d(people[slot], loop));
+      if (depth_m_ > 0) project(p3.people.back(), static_cast<int>(slot));
       p2.people.push_back(person2d(p3.people.back(), static_cast<int>(slot)));
     }
     VideoFrame video;
@@ -130,6 +137,17 @@ class PeopleScriptSource : public Node {
     return p;
   }
 
+  // The exact keypoints of `p` standing at (1.2 slot, 0, depth_m) in the camera frame.
+  void project(Person3D& p, int slot) const {
+    const glm::vec3 root = p.positions[index(Joint::root)];
+    const glm::vec3 at(1.2f * static_cast<float>(slot), 0.0f, depth_m_);
+    for (int j = 0; j < kBodyJoints; ++j) {
+      const glm::vec3 c = p.positions[static_cast<size_t>(j)] - root + at;
+      p.keypoints[static_cast<size_t>(j)] = {320.0f + 600.0f * c.x / c.z,
+                                             240.0f + 600.0f * c.y / c.z, 0.9f};
+    }
+  }
+
   // The body seen from the front, 200 pixels a metre, each person 300 pixels right of the last.
   static Person2D person2d(const Person3D& p3, int slot) {
     std::array<glm::vec2, kBodyJoints> body;
@@ -154,6 +172,7 @@ class PeopleScriptSource : public Node {
   std::vector<std::vector<ScriptPerson>> script_;
   std::vector<std::int64_t> skip_2d_;
   bool repeat_ = false;
+  float depth_m_ = 0.0f;
   std::chrono::nanoseconds interval_{0};
   std::int64_t frame_ = 0;
 };
