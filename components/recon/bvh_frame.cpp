@@ -3,6 +3,10 @@
 #include <stdexcept>
 #include <string>
 
+#include <glm/geometric.hpp>
+#include <glm/gtc/quaternion.hpp>
+#include <glm/mat3x3.hpp>
+
 #include "core/input_error.hpp"
 
 namespace mocap::recon {
@@ -81,7 +85,38 @@ BvhFrameMaker::BvhFrameMaker(const motion::Skeleton& skeleton, const std::string
   mapping_ = motion::map_to_body(pose_.skeleton, source);
 }
 
+std::optional<BvhPlacement> bvh_placement(const People3D& people, const Person3D& person) {
+  if (!person.placed) return std::nullopt;
+  // Camera axes (x right, y down, z forward) into the level world (x right, y up, camera on +Z).
+  const glm::mat3 level_from_camera(glm::vec3(1, 0, 0), glm::vec3(0, -1, 0), glm::vec3(0, 0, -1));
+  BvhPlacement out;
+  if (!people.has_ground) {
+    out.root_m = level_from_camera * person.root.translation;
+    return out;
+  }
+  // World axes in camera coordinates: up is the floor's normal, -Z the camera's forward direction
+  // along the floor.
+  const glm::vec3 up = glm::normalize(people.ground.normal);
+  const glm::vec3 forward(0.0f, 0.0f, 1.0f);
+  glm::vec3 along = forward - glm::dot(forward, up) * up;
+  if (glm::length(along) < 1e-3f) along = glm::vec3(0.0f, 1.0f, 0.0f);  // looking straight down
+  const glm::vec3 z = -glm::normalize(along);
+  const glm::vec3 x = glm::cross(up, z);
+  const glm::mat3 world_from_camera = glm::transpose(glm::mat3(x, up, z));  // rows x, up, z
+  out.root_m = world_from_camera * person.root.translation;
+  out.root_m.y += people.ground.offset;  // the height over the floor
+  out.height_known = true;
+  out.world_from_level = glm::quat_cast(world_from_camera * glm::transpose(level_from_camera));
+  return out;
+}
+
 void BvhFrameMaker::channels(const posedb::Database& db, DatabasePose pose,
+                             std::vector<float>& values) {
+  channels(db, pose, std::nullopt, values);
+}
+
+void BvhFrameMaker::channels(const posedb::Database& db, DatabasePose pose,
+                             const std::optional<BvhPlacement>& placement,
                              std::vector<float>& values) {
   if (pose.frame >= db.frames().size() || pose.view >= db.views().size())
     throw std::out_of_range("BvhFrameMaker: database frame or view out of range");
@@ -91,7 +126,8 @@ void BvhFrameMaker::channels(const posedb::Database& db, DatabasePose pose,
   const std::span<const float> q = db.rotations(pose.frame);
   const motion::Skeleton& skeleton = pose_.skeleton;
   const float yaw = glm::radians(db.views()[pose.view].yaw_deg);
-  const glm::quat turn = glm::angleAxis(-(yaw + record.heading_rad), glm::vec3(0, 1, 0));
+  glm::quat turn = glm::angleAxis(-(yaw + record.heading_rad), glm::vec3(0, 1, 0));
+  if (placement) turn = placement->world_from_level * turn;
   for (int j = 0; j < skeleton.joint_count(); ++j) {
     const auto at = static_cast<std::size_t>(j) * 4;
     const glm::quat source(q[at], q[at + 1], q[at + 2], q[at + 3]);
@@ -105,8 +141,13 @@ void BvhFrameMaker::channels(const posedb::Database& db, DatabasePose pose,
   std::array<glm::vec3, kBodyJoints> body;
   motion::body_positions(mapping_, global_, body);
   const glm::vec3 body_root = body[index(Joint::root)];
-  const glm::vec3 shift =
-      (glm::vec3(0.0f, record.root_m[1], 0.0f) - body_root) / mapping_.metres_per_unit;
+  glm::vec3 target(0.0f, record.root_m[1], 0.0f);
+  if (placement) {
+    target.x = placement->root_m.x;
+    target.z = placement->root_m.z;
+    if (placement->height_known) target.y = placement->root_m.y;
+  }
+  const glm::vec3 shift = (target - body_root) / mapping_.metres_per_unit;
   for (int j = 0; j < skeleton.joint_count(); ++j) {
     if (skeleton.joints[j].parent < 0) pose_.translation[j] = shift;
   }
@@ -120,12 +161,13 @@ void BvhFrameMaker::enable_smoothing(const OneEuroParams& params) {
 }
 
 void BvhFrameMaker::channels(const posedb::Database& db, DatabasePose pose, double t_seconds,
-                             std::vector<float>& values) {
+                             std::vector<float>& values,
+                             const std::optional<BvhPlacement>& placement) {
   if (rotation_filters_.empty()) {
-    channels(db, pose, values);
+    channels(db, pose, placement, values);
     return;
   }
-  channels(db, pose, values);  // fills pose_ with this frame's rotations and root
+  channels(db, pose, placement, values);  // fills pose_ with this frame's rotations and root
   smooth(t_seconds);
   values = motion::to_clip(pose_).values;
 }

@@ -41,15 +41,17 @@ void PeopleBvhWriter::write(const People3D& people) {
   for (const Person3D& person : people.people) {
     if (person.id < 0) continue;  // not tracked: no identity to give a file
     const auto track = tracks_.find(person.id);
+    const std::optional<BvhPlacement> placement = bvh_placement(people, person);
     if (track == tracks_.end()) {
-      start(person, frame);
+      start(person, frame, placement);
     } else {
-      append(track->second, person, frame);
+      append(track->second, person, frame, placement);
     }
   }
 }
 
-void PeopleBvhWriter::start(const Person3D& person, std::int64_t frame) {
+void PeopleBvhWriter::start(const Person3D& person, std::int64_t frame,
+                            const std::optional<BvhPlacement>& placement) {
   const std::optional<DatabasePose> pose = database_pose_of(db_, person);
   if (!pose) {
     ++summary_.no_provenance;
@@ -63,7 +65,7 @@ void PeopleBvhWriter::start(const Person3D& person, std::int64_t frame) {
   BvhFrameMaker maker(skeleton, db_.clips()[db_.frames()[pose->frame].clip].source);
   if (options_.smooth_rotations) maker.enable_smoothing(options_.smoothing);
   std::vector<float> values;
-  maker.channels(db_, *pose, seconds(frame), values);
+  maker.channels(db_, *pose, seconds(frame), values, placement);
   Track& track =
       tracks_
           .emplace(person.id,
@@ -94,7 +96,8 @@ double PeopleBvhWriter::seconds(std::int64_t frame) const {
   return static_cast<double>(frame) / options_.fps;
 }
 
-void PeopleBvhWriter::append(Track& track, const Person3D& person, std::int64_t frame) {
+void PeopleBvhWriter::append(Track& track, const Person3D& person, std::int64_t frame,
+                             const std::optional<BvhPlacement>& placement) {
   if (frame == track.last_frame) return;  // the same id twice in one frame: the first one counts
   for (std::int64_t missed = track.last_frame + 1; missed < frame; ++missed) {
     emit(person.id, track);
@@ -106,7 +109,7 @@ void PeopleBvhWriter::append(Track& track, const Person3D& person, std::int64_t 
   } else if (!same_hierarchy(source_skeleton(db_, pose->frame), track.maker.skeleton())) {
     ++summary_.skeleton_mismatch;
   } else {
-    track.maker.channels(db_, *pose, seconds(frame), track.values);
+    track.maker.channels(db_, *pose, seconds(frame), track.values, placement);
   }
   emit(person.id, track);
   track.last_frame = frame;

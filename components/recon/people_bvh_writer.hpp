@@ -74,8 +74,10 @@ class PeopleBvhWriter {
   };
 
   double seconds(std::int64_t frame) const;
-  void start(const Person3D& person, std::int64_t frame);
-  void append(Track& track, const Person3D& person, std::int64_t frame);
+  void start(const Person3D& person, std::int64_t frame,
+             const std::optional<BvhPlacement>& placement);
+  void append(Track& track, const Person3D& person, std::int64_t frame,
+              const std::optional<BvhPlacement>& placement);
   void emit(int id, Track& track);  // one frame: track.values
   void keep_open_files_bounded(int arriving_id);
 

@@ -1,8 +1,11 @@
 // sink.jsonl: one JSON line per input frame, in input order:
-//   {"frame": 0, "time": 0.0, "people": [{"id": 1, "joints": {"head": [x, y, z], ...}}]}
-// with the 15 body joint names, metres, camera coordinates (x right, y down, z forward),
-// root-relative while no translation is estimated. Each line is flushed as it is written, so the
-// file holds every finished frame even if the run is killed.
+//   {"frame": 0, "time": 0.0, "people": [{"id": 1, "joints": {"head": [x, y, z], ...},
+//    "joints_abs": {...}}], "ground": {"normal": [x, y, z], "offset": d}}
+// with the 15 body joint names, metres, camera coordinates (x right, y down, z forward).
+// `joints` are root-relative; `joints_abs` (absolute camera-frame positions) appear for people
+// whose root translation is estimated (recon.fit), `ground` once the floor is known (points p
+// with normal . p + offset = 0, normal up). Each line is flushed as it is written, so the file
+// holds every finished frame even if the run is killed.
 
 #include <cstdio>
 #include <memory>
@@ -31,16 +34,17 @@ class JsonLinesSink : public Node {
     const auto& in = ctx.input<People3D>("in");
     nlohmann::ordered_json people = nlohmann::ordered_json::array();
     for (const Person3D& p : in.people) {
-      nlohmann::ordered_json joints = nlohmann::ordered_json::object();
-      for (int j = 0; j < kBodyJoints; ++j) {
-        joints[std::string(kJointNames[j])] = {
-            round_mm(p.positions[j].x), round_mm(p.positions[j].y), round_mm(p.positions[j].z)};
-      }
-      people.push_back({{"id", p.id}, {"joints", joints}});
+      nlohmann::ordered_json person = {{"id", p.id}, {"joints", joints_of(p, glm::vec3(0.0f))}};
+      if (p.placed) person["joints_abs"] = joints_of(p, p.root.translation);
+      people.push_back(std::move(person));
     }
-    const nlohmann::ordered_json line = {{"frame", in.header.frame},
-                                         {"time", static_cast<double>(in.header.capture_ns) * 1e-9},
-                                         {"people", people}};
+    nlohmann::ordered_json line = {{"frame", in.header.frame},
+                                   {"time", static_cast<double>(in.header.capture_ns) * 1e-9},
+                                   {"people", people}};
+    if (in.has_ground) {
+      line["ground"] = {{"normal", {in.ground.normal.x, in.ground.normal.y, in.ground.normal.z}},
+                        {"offset", round_mm(in.ground.offset)}};
+    }
     const std::string text = line.dump() + "\n";
     if (std::fwrite(text.data(), 1, text.size(), file_.get()) != text.size() ||
         std::fflush(file_.get()) != 0) {
@@ -50,6 +54,14 @@ class JsonLinesSink : public Node {
   void close(Context&) override { file_.reset(); }
 
  private:
+  static nlohmann::ordered_json joints_of(const Person3D& p, const glm::vec3& shift) {
+    nlohmann::ordered_json joints = nlohmann::ordered_json::object();
+    for (int j = 0; j < kBodyJoints; ++j) {
+      const glm::vec3 v = p.positions[static_cast<std::size_t>(j)] + shift;
+      joints[std::string(kJointNames[j])] = {round_mm(v.x), round_mm(v.y), round_mm(v.z)};
+    }
+    return joints;
+  }
   // Millimetre precision keeps the file small and the numbers readable.
   static double round_mm(float v) { return std::round(static_cast<double>(v) * 1000.0) / 1000.0; }
   struct Closer {
