@@ -103,9 +103,11 @@ void configure_video(graph::GraphSpec& spec, const Args& args, const VideoInfo& 
   const double fps = args.has("fps") ? std::stod(args.get("fps")) : info.fps > 0 ? info.fps : 30.0;
   for (const char* type : {"sink.bvh", "sink.overlay"}) set_param(spec, type, "fps", number(fps));
   const std::string width = std::to_string(info.width), height = std::to_string(info.height);
-  set_param(spec, "recon.temporal_selector", "image_width", width);
-  set_param(spec, "recon.temporal_selector", "image_height", height);
-  set_param(spec, "recon.temporal_selector", "hfov_deg", args.get("hfov"));
+  for (const char* type : {"recon.temporal_selector", "recon.fit"}) {
+    set_param(spec, type, "image_width", width);
+    set_param(spec, type, "image_height", height);
+    set_param(spec, type, "hfov_deg", args.get("hfov"));
+  }
   set_param(spec, "sink.overlay", "canvas_width", width);
   set_param(spec, "sink.overlay", "canvas_height", height);
 }
@@ -135,13 +137,35 @@ std::string matcher_layout_offsets(const std::string& setting, const std::string
   return std::string(layout(first.layout).name);
 }
 
+// What --fit means: auto fits the whole sequence of a file (offline), with a fixed lag for a live
+// source, and not at all for keypoints whose camera is unknown (JSON without --image-size or
+// --camera: nothing tells where the camera's rays go).
+std::string fit_mode(const Args& args, InputKind kind, bool live) {
+  const std::string fit = args.get("fit");
+  if (fit != "auto" && fit != "off" && fit != "live" && fit != "full")
+    throw InputError("--fit", "expected auto, off, live or full, got '" + fit + "'");
+  const bool camera_known =
+      kind == InputKind::video || args.has("image-size") || args.has("camera");
+  if (fit == "auto") {
+    if (!camera_known) {
+      std::cerr << "mocap reconstruct: no skeleton fitting (no root translation): the keypoints' "
+                   "image size is unknown; give --image-size WxH or --camera FILE\n";
+      return "off";
+    }
+    return live ? "live" : "full";
+  }
+  if (fit != "off" && !camera_known)
+    throw InputError("--fit", "fitting needs the camera: give --image-size WxH or --camera FILE");
+  return fit;
+}
+
 void configure(graph::GraphSpec& spec, const Args& args, const fs::path& out, InputKind kind) {
   set_param(spec, "source.openpose_json", "path", args.positionals()[0]);
   const std::string fps = args.has("fps") ? args.get("fps") : "30";
   for (const char* type : {"source.openpose_json", "sink.bvh", "sink.overlay"})
     set_param(spec, type, "fps", fps);
   for (const char* type :
-       {"recon.scaler", "recon.matcher", "recon.temporal_selector", "sink.bvh"}) {
+       {"recon.scaler", "recon.matcher", "recon.temporal_selector", "recon.fit", "sink.bvh"}) {
     set_param(spec, type, "db", args.get("db"));
   }
   set_param(spec, "recon.temporal_selector", "mode", args.get("mode"));
@@ -155,11 +179,16 @@ void configure(graph::GraphSpec& spec, const Args& args, const fs::path& out, In
       throw InputError("--image-size",
                        "expected WIDTHxHEIGHT in pixels, e.g. 1920x1080, got '" + size + "'");
     }
-    set_param(spec, "recon.temporal_selector", "image_width", size.substr(0, x));
-    set_param(spec, "recon.temporal_selector", "image_height", size.substr(x + 1));
-    set_param(spec, "recon.temporal_selector", "hfov_deg", args.get("hfov"));
+    for (const char* type : {"recon.temporal_selector", "recon.fit"}) {
+      set_param(spec, type, "image_width", size.substr(0, x));
+      set_param(spec, type, "image_height", size.substr(x + 1));
+      set_param(spec, type, "hfov_deg", args.get("hfov"));
+    }
   }
-  if (args.has("camera")) set_param(spec, "recon.temporal_selector", "camera", args.get("camera"));
+  if (args.has("camera")) {
+    for (const char* type : {"recon.temporal_selector", "recon.fit"})
+      set_param(spec, type, "camera", args.get("camera"));
+  }
   set_param(spec, "sink.jsonl", "path", (out / "poses.jsonl").string());
   set_param(spec, "sink.bvh", "dir", out.string());
   set_param(spec, "sink.overlay", "video", (out / "overlay.mp4").string());
@@ -170,7 +199,7 @@ void configure(graph::GraphSpec& spec, const Args& args, const fs::path& out, In
 json summarize_output(const fs::path& jsonl) {
   std::ifstream in(jsonl);
   std::map<int, int> frames_per_id;
-  std::size_t frames = 0, person_frames = 0;
+  std::size_t frames = 0, person_frames = 0, placed = 0;
   for (std::string line; std::getline(in, line);) {
     const json j = json::parse(line, nullptr, false);
     if (j.is_discarded()) continue;
@@ -178,6 +207,7 @@ json summarize_output(const fs::path& jsonl) {
     for (const auto& p : j.value("people", json::array())) {
       ++frames_per_id[p.value("id", -1)];
       ++person_frames;
+      placed += p.contains("joints_abs") ? 1 : 0;
     }
   }
   int long_tracks = 0;
@@ -185,6 +215,7 @@ json summarize_output(const fs::path& jsonl) {
   return {{"frames", frames},
           {"people", frames_per_id.size()},
           {"person_frames", person_frames},
+          {"placed_person_frames", placed},
           {"tracks_longer_than_50_frames", long_tracks}};
 }
 
@@ -206,7 +237,8 @@ int reconstruct_command(int argc, char** argv) {
       "RTSP/HTTP stream or folder of images (people found by MoveNet), or in a folder of OpenPose\n"
       "*_keypoints.json files (BODY_25, BODY_25B, COCO-18). Writes into DIR: poses.jsonl (one "
       "line\n"
-      "per input frame: 15 joints per person, metres, camera coordinates, root-relative),\n"
+      "per input frame: 15 joints per person, metres, camera coordinates, root-relative, and\n"
+      "absolute under joints_abs once fitted), "
       "person_<id>.bvh per person, overlay.mp4 (the input beside the 3D skeletons) and "
       "summary.json.");
   args.positional("INPUT",
@@ -229,6 +261,15 @@ int reconstruct_command(int argc, char** argv) {
       .option("camera", "FILE",
               "calibrated camera (OpenCV YAML from `mocap calibrate intrinsics`): its matrix and "
               "lens distortion replace --image-size/--hfov for the ray through each root")
+      .option("fit", "auto|off|live|full",
+              "skeleton fitting (root translation, the person's bones, feet on the floor): full "
+              "over the whole sequence, live with a 3-frame lag; auto: full for files, live for "
+              "cameras and streams, off for OpenPose JSON without --image-size/--camera",
+              "auto")
+      .option("ground", "auto|feet|off",
+              "the floor for the fitting: auto takes the camera file's (`mocap calibrate "
+              "ground`), else estimates it from the people's feet",
+              "auto")
       .option("mode", "NAME",
               "temporal selection: path (Viterbi, lag 8), greedy (the paper) or nearest", "path")
       .option("layout-offsets", "auto|off|FILE",
@@ -266,6 +307,9 @@ int reconstruct_command(int argc, char** argv) {
   graph::GraphSpec spec = graph::load_graph_file(graph_file);
   configure(spec, args, out, kind);
   if (kind == InputKind::video) configure_video(spec, args, info);
+  const std::string fit = fit_mode(args, kind, info.live);
+  set_param(spec, "recon.fit", "mode", fit);
+  set_param(spec, "recon.fit", "ground", args.get("ground"));
   graph::apply_overrides(spec, args.all("set"));
   check_detector_model(spec);
   const graph::ResolvedGraph resolved = graph::resolve(std::move(spec));
@@ -293,6 +337,7 @@ int reconstruct_command(int argc, char** argv) {
   summary["input"] = args.positionals()[0];
   summary["database"] = args.get("db");
   summary["mode"] = args.get("mode");
+  summary["fit"] = fit;
   summary["graph"] = graph_file;
   if (kind == InputKind::video) {
     summary["detector_size"] = std::stoi(args.get("detector-size"));
