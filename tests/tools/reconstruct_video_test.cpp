@@ -63,14 +63,31 @@ TEST_F(ReconstructVideoTest, AVideoBecomesPosesBvhAndAnOverlayVideo) {
   const std::string out = dir_->file("out");
   const auto lines = test::read_lines(out + "/poses.jsonl");
   ASSERT_EQ(lines.size(), 30u);
-  std::size_t people = 0;
+  std::size_t people = 0, placed = 0, grounded = 0;
   for (std::size_t i = 0; i < lines.size(); ++i) {
     const auto j = nlohmann::json::parse(lines[i]);
     EXPECT_EQ(j.at("frame").get<std::size_t>(), i);
     EXPECT_NEAR(j.at("time").get<double>(), 0.1 * static_cast<double>(i), 0.011);  // 10 fps
     people += j.at("people").size();
+    for (const auto& person : j.at("people")) {
+      if (!person.contains("joints_abs")) continue;
+      ++placed;
+      const auto& root = person.at("joints_abs").at("root");
+      EXPECT_GT(root[2].get<double>(), 1.0);  // in front of the camera, in the mall
+      EXPECT_LT(root[2].get<double>(), 60.0);
+      if (!j.contains("ground")) continue;
+      // The fitted hips stand at hip height over the floor estimated from the feet.
+      const auto& n = j.at("ground").at("normal");
+      double height = j.at("ground").at("offset").get<double>();
+      for (int k = 0; k < 3; ++k) height += n[k].get<double>() * root[k].get<double>();
+      EXPECT_GT(height, 0.5);
+      EXPECT_LT(height, 1.3);
+      ++grounded;
+    }
   }
-  EXPECT_GT(people, 30u);  // pedestrians are found: more than one per frame on average
+  EXPECT_GT(people, 30u);              // pedestrians are found: more than one per frame on average
+  EXPECT_GE(placed, people * 9 / 10);  // the fit (full, by default for a file) placed them
+  EXPECT_GT(grounded, 0u);
   EXPECT_GT(fs::file_size(out + "/overlay.mp4"), 10000u);
   bool bvh = false;
   for (const auto& e : fs::directory_iterator(out)) bvh = bvh || e.path().extension() == ".bvh";
@@ -80,6 +97,7 @@ TEST_F(ReconstructVideoTest, AVideoBecomesPosesBvhAndAnOverlayVideo) {
   EXPECT_EQ(summary.at("video").at("height"), 576);
   EXPECT_EQ(summary.at("detector_size"), 384);
   EXPECT_EQ(summary.at("frames"), 30);
+  EXPECT_EQ(summary.at("fit"), "full");
   EXPECT_NE(run.out().find(out + "/overlay.mp4"), std::string::npos) << run.out();
 }
 
