@@ -106,28 +106,6 @@ std::array<double, 3> solve3(const std::array<std::array<double, 3>, 3>& m,
   return x;
 }
 
-std::vector<double> numbers_in(std::string_view s) {
-  std::vector<double> out;
-  std::size_t i = 0;
-  while (i < s.size()) {
-    const char c = s[i];
-    if ((c >= '0' && c <= '9') || c == '-' || c == '+' || c == '.') {
-      std::size_t j = i;
-      while (j < s.size() &&
-             std::string_view("0123456789+-.eE").find(s[j]) != std::string_view::npos)
-        ++j;
-      double v = 0.0;
-      const auto [ptr, ec] = std::from_chars(s.data() + i, s.data() + j, v);
-      if (ec != std::errc() || ptr != s.data() + j || !std::isfinite(v)) return {};
-      out.push_back(v);
-      i = j;
-    } else {
-      ++i;
-    }
-  }
-  return out;
-}
-
 }  // namespace
 
 std::vector<CalibrationFrame> pose2sim_frames(const io::TrcFile& trc, LayoutId layout) {
@@ -304,106 +282,40 @@ std::array<JointFit, kBodyJoints> evaluate_offsets_3d(const recon::LayoutOffsets
   return out;
 }
 
-glm::dvec3 Pose2SimCamera::project_trc(const glm::vec3& trc) const {
-  const glm::dvec3 w(trc.z, trc.x, trc.y);
-  const glm::dvec3 c(R[0] * w.x + R[1] * w.y + R[2] * w.z + t.x,
-                     R[3] * w.x + R[4] * w.y + R[5] * w.z + t.y,
-                     R[6] * w.x + R[7] * w.y + R[8] * w.z + t.z);
-  return {fx * c.x / c.z + cx, fy * c.y / c.z + cy, c.z};
+namespace {
+
+// Pixel (x, y) and depth (metres along the optical axis) of a TRC point (Y up) in a camera of the
+// Z-up calibration world.
+glm::dvec3 project_trc(const camera::Pose2SimCamera& cam, const glm::vec3& trc) {
+  const glm::dvec3 world(trc.z, trc.x, trc.y);
+  const glm::dvec2 pixel = cam.project(world);
+  return {pixel.x, pixel.y, cam.to_camera(world).z};
 }
 
-std::vector<Pose2SimCamera> read_pose2sim_cameras(const std::filesystem::path& toml) {
-  const std::string text = io::read_whole_file(toml, 1u << 20);
-  const std::string file = toml.string();
-  std::vector<Pose2SimCamera> cameras;
-  struct Seen {
-    bool matrix = false, rotation = false, translation = false;
-  };
-  std::vector<Seen> seen;
-  long line_number = 0;
-  std::size_t pos = 0;
-  while (pos < text.size()) {
-    std::size_t end = text.find('\n', pos);
-    if (end == std::string::npos) end = text.size();
-    const std::string_view line(text.data() + pos, end - pos);
-    pos = end + 1;
-    ++line_number;
-    if (line.starts_with("[metadata")) {
-      cameras.emplace_back();  // a sentinel: keys after it belong to no camera
-      seen.push_back({true, true, true});
-      cameras.back().name = "";
-      continue;
-    }
-    if (line.starts_with("[")) {
-      cameras.emplace_back();
-      cameras.back().name = std::string(line.substr(1, line.find(']') - 1));
-      seen.emplace_back();
-      continue;
-    }
-    const auto eq = line.find('=');
-    if (eq == std::string_view::npos || cameras.empty() || cameras.back().name.empty()) continue;
-    const std::string_view key = line.substr(0, line.find_first_of(" =\t"));
-    const auto v = numbers_in(line.substr(eq + 1));
-    Pose2SimCamera& cam = cameras.back();
-    if (key == "matrix") {
-      if (v.size() != 9 || v[0] <= 0 || v[4] <= 0)
-        throw InputError(file, line_number, "'matrix' must be 3x3 numbers with fx, fy > 0");
-      cam.fx = v[0];
-      cam.cx = v[2];
-      cam.fy = v[4];
-      cam.cy = v[5];
-      seen.back().matrix = true;
-    } else if (key == "rotation") {
-      if (v.size() != 3) throw InputError(file, line_number, "'rotation' must be 3 numbers");
-      const glm::dvec3 r(v[0], v[1], v[2]);
-      const double theta = glm::length(r);
-      const glm::dvec3 k = theta > 0 ? r / theta : glm::dvec3(1, 0, 0);
-      const double c = std::cos(theta), s = std::sin(theta), C = 1 - c;
-      cam.R = {c + k.x * k.x * C,       k.x * k.y * C - k.z * s, k.x * k.z * C + k.y * s,
-               k.y * k.x * C + k.z * s, c + k.y * k.y * C,       k.y * k.z * C - k.x * s,
-               k.z * k.x * C - k.y * s, k.z * k.y * C + k.x * s, c + k.z * k.z * C};
-      seen.back().rotation = true;
-    } else if (key == "translation") {
-      if (v.size() != 3) throw InputError(file, line_number, "'translation' must be 3 numbers");
-      cam.t = {v[0], v[1], v[2]};
-      seen.back().translation = true;
-    }
-  }
-  std::vector<Pose2SimCamera> out;
-  for (std::size_t i = 0; i < cameras.size(); ++i) {
-    if (cameras[i].name.empty()) continue;
-    if (!seen[i].matrix || !seen[i].rotation || !seen[i].translation)
-      throw InputError(file, line_number,
-                       "camera '" + cameras[i].name +
-                           "' lacks matrix, rotation or translation (file truncated?)");
-    out.push_back(cameras[i]);
-  }
-  if (out.empty()) throw InputError(file, "no camera sections: not a Pose2Sim calibration");
-  return out;
-}
+}  // namespace
 
-std::array<JointFit, kBodyJoints> evaluate_offsets_2d(const recon::LayoutOffsets& offsets,
-                                                      std::span<const CalibrationFrame> frames,
-                                                      std::span<const Pose2SimCamera> cameras) {
+std::array<JointFit, kBodyJoints> evaluate_offsets_2d(
+    const recon::LayoutOffsets& offsets, std::span<const CalibrationFrame> frames,
+    std::span<const camera::Pose2SimCamera> cameras) {
   std::array<JointFit, kBodyJoints> out{};
-  for (const Pose2SimCamera& cam : cameras) {
+  for (const camera::Pose2SimCamera& cam : cameras) {
     for (const CalibrationFrame& c : frames) {
       std::array<float, kBodyJoints * 3> body;
       std::array<glm::dvec3, kBodyJoints> reference;
       for (int j = 0; j < kBodyJoints; ++j) {
         const bool ok = finite(c.keypoints[j]);
-        const glm::dvec3 p = ok ? cam.project_trc(c.keypoints[j]) : glm::dvec3(0.0);
+        const glm::dvec3 p = ok ? project_trc(cam, c.keypoints[j]) : glm::dvec3(0.0);
         body[3 * j] = ok ? static_cast<float>(p.x) : kNan;
         body[3 * j + 1] = ok ? static_cast<float>(p.y) : kNan;
         body[3 * j + 2] = ok && p.z > 0 ? 1.0f : 0.0f;
-        reference[j] = finite(c.reference[j]) ? cam.project_trc(c.reference[j]) : glm::dvec3(kNan);
+        reference[j] = finite(c.reference[j]) ? project_trc(cam, c.reference[j]) : glm::dvec3(kNan);
       }
       std::array<float, kBodyJoints* 3> corrected = body;
       recon::apply_layout_offsets(offsets, corrected);
       for (int j = 0; j < kBodyJoints; ++j) {
         if (body[3 * j + 2] <= 0.0f || !std::isfinite(reference[j].z) || reference[j].z <= 0)
           continue;
-        const double mm_per_px = 1000.0 * reference[j].z / cam.fx;
+        const double mm_per_px = 1000.0 * reference[j].z / cam.intrinsics.fx();
         const glm::dvec2 ref(reference[j].x, reference[j].y);
         JointFit& f = out[j];
         f.before_mm += mm_per_px * glm::length(glm::dvec2(body[3 * j], body[3 * j + 1]) - ref);

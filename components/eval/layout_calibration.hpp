@@ -23,6 +23,7 @@
 
 #include <glm/vec3.hpp>
 
+#include "camera/pose2sim_calibration.hpp"
 #include "core/body15.hpp"
 #include "core/keypoint_layout.hpp"
 #include "io/humaneva.hpp"
@@ -85,24 +86,13 @@ LayoutFit fit_layout_offsets(LayoutId layout, std::span<const CalibrationFrame> 
 std::array<JointFit, kBodyJoints> evaluate_offsets_3d(const recon::LayoutOffsets& offsets,
                                                       std::span<const CalibrationFrame> frames);
 
-// A pinhole camera of Pose2Sim's Calib_qualisys.toml: x ~ K (R X_w + t), X_w in the Z-up world
-// frame; TRC points (Y up) are turned into it with X_w = Z_trc, Y_w = X_trc, Z_w = Y_trc.
-struct Pose2SimCamera {
-  std::string name;
-  double fx = 1.0, fy = 1.0, cx = 0.0, cy = 0.0;
-  std::array<double, 9> R{1, 0, 0, 0, 1, 0, 0, 0, 1};  // row-major, from the Rodrigues vector
-  glm::dvec3 t{0.0};
-  // Pixel (x, y) and depth (metres along the optical axis) of a TRC point.
-  glm::dvec3 project_trc(const glm::vec3& trc) const;
-};
-// Throws InputError naming the file and line.
-std::vector<Pose2SimCamera> read_pose2sim_cameras(const std::filesystem::path& toml);
-
-// The 2D check: keypoints and reference projected through each camera, the 2D correction
+// The 2D check: keypoints and reference (TRC points, Y up; the calibration's world is Z up:
+// X_w = Z_trc, Y_w = X_trc, Z_w = Y_trc) projected through each camera of a Pose2Sim calibration
+// (camera/pose2sim_calibration.hpp), the 2D correction
 // applied to the projected keypoints; mean distance before/after per joint, in millimetres at
 // the joint's depth (pixels * depth / f).
-std::array<JointFit, kBodyJoints> evaluate_offsets_2d(const recon::LayoutOffsets& offsets,
-                                                      std::span<const CalibrationFrame> frames,
-                                                      std::span<const Pose2SimCamera> cameras);
+std::array<JointFit, kBodyJoints> evaluate_offsets_2d(
+    const recon::LayoutOffsets& offsets, std::span<const CalibrationFrame> frames,
+    std::span<const camera::Pose2SimCamera> cameras);
 
 }  // namespace mocap::eval

@@ -235,7 +235,7 @@ int layout_command(int argc, char** argv) {
                                eval::evaluate_offsets_3d(other.offsets, trials[a].frames));
     }
     const fs::path toml = fs::path(args.get("pose2sim")) / "calibration" / "Calib_qualisys.toml";
-    const auto cameras = eval::read_pose2sim_cameras(toml);
+    const auto cameras = camera::read_pose2sim_calibration(toml);
     std::cout << "\n"
               << check_table("## " + std::string(lay->name) +
                                  ": 2D check, keypoints and reference projected through the " +
