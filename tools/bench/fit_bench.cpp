@@ -60,6 +60,76 @@ void print_row(const std::string& name, const std::string& condition, const Row&
   std::cout << " |\n";
 }
 
+std::vector<std::string> split_commas(const std::string& text) {
+  std::vector<std::string> out;
+  std::size_t start = 0;
+  while (start <= text.size()) {
+    const std::size_t end = std::min(text.find(',', start), text.size());
+    if (end > start) out.push_back(text.substr(start, end - start));
+    start = end + 1;
+  }
+  return out;
+}
+
+// A named weight of FitWeights that `--sweep NAME=V1,V2` may vary; nullptr when unknown.
+double* sweep_weight(fit::FitWeights& w, const std::string& name) {
+  if (name == "prior") return &w.prior_rad;
+  if (name == "reprojection") return &w.reprojection;
+  if (name == "bone-accel") return &w.bone_accel_m;
+  if (name == "root-accel") return &w.root_accel_m;
+  if (name == "translation-prior") return &w.translation_prior_m;
+  if (name == "bone-prior") return &w.bone_prior_m;
+  if (name == "symmetry") return &w.symmetry_m;
+  if (name == "body-scale") return &w.body_scale;
+  if (name == "knee-limit") return &w.knee_limit;
+  if (name == "slide") return &w.slide_m;
+  if (name == "ground") return &w.ground_m;
+  return nullptr;
+}
+
+struct Variant {
+  std::string label;  // empty for the base options
+  fit::FitOptions options;
+};
+
+// The base options, then one variant per `--sweep` value (every other weight at the base), then
+// the `--variant` combinations (`NAME=V,NAME=V`, all changed together).
+std::vector<Variant> make_variants(const fit::FitOptions& base,
+                                   const std::vector<std::string>& sweeps,
+                                   const std::vector<std::string>& combos) {
+  std::vector<Variant> out{{"", base}};
+  auto assign = [](fit::FitOptions& o, const std::string& name, const std::string& value) {
+    double* w = sweep_weight(o.weights, name);
+    if (w == nullptr) throw InputError("--sweep/--variant", "unknown weight '" + name + "'");
+    try {
+      *w = std::stod(value);
+    } catch (const std::exception&) {
+      throw InputError("--sweep/--variant", "not a number: '" + value + "'");
+    }
+  };
+  for (const auto& s : sweeps) {
+    const auto eq = s.find('=');
+    if (eq == std::string::npos) throw InputError("--sweep", "expected NAME=V1,V2: '" + s + "'");
+    const std::string name = s.substr(0, eq);
+    for (const auto& v : split_commas(s.substr(eq + 1))) {
+      Variant x{name + "=" + v, base};
+      assign(x.options, name, v);
+      out.push_back(std::move(x));
+    }
+  }
+  for (const auto& c : combos) {
+    Variant x{c, base};
+    for (const auto& item : split_commas(c)) {
+      const auto eq = item.find('=');
+      if (eq == std::string::npos)
+        throw InputError("--variant", "expected NAME=V,NAME=V: '" + c + "'");
+      assign(x.options, item.substr(0, eq), item.substr(eq + 1));
+    }
+    out.push_back(std::move(x));
+  }
+  return out;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -69,7 +139,10 @@ int main(int argc, char** argv) {
                  "core.");
   args.option("db", "FILE", "pose database built from the train split", "build/db/cmu31_train.mdb")
       .option("mocap", "DIR", "cmu31 folder with splits.txt", "../shared/data/mocap/cmu31")
-      .option("clips", "N", "held-out clips used (0 = all)", "4")
+      .option("clips", "N", "evaluated clips used, the first N (0 = all)", "4")
+      .option("eval-split", "NAME", "split of splits.txt whose clips are evaluated", "heldout")
+      .option("eval-clips", "A,B", "only these clips of the split (names, e.g. 08_01,08_02)")
+      .option("eval-files", "A.bvh,B.bvh", "evaluate these mocap files instead of a split")
       .option("max-frames", "N", "frames per clip at most (0 = all)", "240")
       .option("lag", "N", "live mode: frames of delay", "3")
       .option("live-iterations", "N", "live mode: solver iterations per frame", "8")
@@ -87,14 +160,43 @@ int main(int argc, char** argv) {
       .option("root-accel", "M", "sigma of root acceleration, m/frame²", "0.01")
       .option("velocity", "M", "live lag 0: sigma of bone and root velocity, m/frame", "0.03")
       .option("translation-prior", "M", "sigma of the root from its closed-form start", "1.0")
-      .option("bone-prior", "M", "full mode: sigma of a bone length from its initial value",
-              "0.01");
+      .option("bone-prior", "M", "full mode: sigma of a bone length from its initial value", "0.01")
+      .option("sweep", "NAME=V1,V2",
+              "also fit with each value of one weight (the others as given; retrieval shared); "
+              "names: prior reprojection bone-accel root-accel translation-prior bone-prior "
+              "symmetry body-scale knee-limit slide ground",
+              std::nullopt, true)
+      .option("variant", "NAME=V,NAME=V", "also fit with these weights changed together",
+              std::nullopt, true);
   int code = 0;
   if (!args.parse(argc - 1, argv + 1, code)) return code;
   try {
     const posedb::Database db = posedb::Database::open(args.get("db"));
     const double fps = db.build_info().fps;
-    auto truth = eval::load_truth(posedb::split_files(args.get("mocap"), "heldout"), fps);
+    std::vector<std::string> files;
+    if (args.has("eval-files")) {
+      files = split_commas(args.get("eval-files"));
+    } else {
+      files = posedb::split_files(args.get("mocap"), args.get("eval-split"));
+      if (args.has("eval-clips")) {
+        const auto wanted = split_commas(args.get("eval-clips"));
+        std::vector<std::string> kept;
+        for (const auto& w : wanted) {
+          const auto it = std::find_if(files.begin(), files.end(), [&](const std::string& f) {
+            return std::filesystem::path(f).stem().string() == w;
+          });
+          if (it == files.end())
+            throw InputError(args.get("mocap"),
+                             "no clip " + w + " in split '" + args.get("eval-split") + "'");
+          kept.push_back(*it);
+        }
+        files = kept;
+      }
+    }
+    if (files.empty())
+      throw InputError(args.get("mocap"),
+                       "no clips to evaluate (split '" + args.get("eval-split") + "' is empty)");
+    auto truth = eval::load_truth(files, fps);
     if (const long n = args.integer("clips"); n > 0 && static_cast<std::size_t>(n) < truth.size())
       truth.resize(n);
     if (const long n = args.integer("max-frames"); n > 0)
@@ -131,6 +233,7 @@ int main(int argc, char** argv) {
     options.weights.translation_prior_m = args.number("translation-prior");
     options.weights.bone_velocity_m = options.weights.root_velocity_m = args.number("velocity");
     const bool use_contact = !args.has("no-contact");
+    const auto variants = make_variants(options, args.all("sweep"), args.all("variant"));
 
     const std::vector<std::string> methods = {"truth", "retrieval only", "+ fit, full sequence",
                                               "+ fit, live"};
@@ -177,40 +280,45 @@ int main(int argc, char** argv) {
             r.placement = placement(fit::placed_retrieval(inputs, pinhole));
             rows[{methods[1], cond}].add(r);
           }
-          {
-            const auto start = Clock::now();
-            const auto result = fit::fit_sequence(inputs, options);
-            Row r;
-            r.seconds = seconds_since(start);
-            r.frames = static_cast<double>(inputs.size());
-            r.pose = eval::score(fit::as_poses(result.frames), rendered.truth_camera);
-            r.placement = placement(result.frames);
-            rows[{methods[2], cond}].add(r);
-          }
-          {
-            const auto start = Clock::now();
-            fit::LiveFitter live(options);
-            std::vector<fit::FittedFrame> out;
-            for (const auto& in : inputs)
-              if (auto f = live.push(in)) out.push_back(*f);
-            for (auto& f : live.finish()) out.push_back(f);
-            Row r;
-            r.seconds = seconds_since(start);
-            r.frames = static_cast<double>(inputs.size());
-            r.pose = eval::score(fit::as_poses(out), rendered.truth_camera);
-            r.placement = placement(out);
-            rows[{methods[3], cond}].add(r);
+          for (const auto& v : variants) {
+            const std::string suffix = v.label.empty() ? "" : " [" + v.label + "]";
+            {
+              const auto start = Clock::now();
+              const auto result = fit::fit_sequence(inputs, v.options);
+              Row r;
+              r.seconds = seconds_since(start);
+              r.frames = static_cast<double>(inputs.size());
+              r.pose = eval::score(fit::as_poses(result.frames), rendered.truth_camera);
+              r.placement = placement(result.frames);
+              rows[{methods[2] + suffix, cond}].add(r);
+            }
+            {
+              const auto start = Clock::now();
+              fit::LiveFitter live(v.options);
+              std::vector<fit::FittedFrame> out;
+              for (const auto& in : inputs)
+                if (auto f = live.push(in)) out.push_back(*f);
+              for (auto& f : live.finish()) out.push_back(f);
+              Row r;
+              r.seconds = seconds_since(start);
+              r.frames = static_cast<double>(inputs.size());
+              r.pose = eval::score(fit::as_poses(out), rendered.truth_camera);
+              r.placement = placement(out);
+              rows[{methods[3] + suffix, cond}].add(r);
+            }
           }
           std::cerr << "." << std::flush;
         }
       }
     }
     std::cerr << "\n";
-    std::cout << truth.size() << " held-out clips (first " << args.get("max-frames")
-              << " frames each), " << frames << " frames at " << fps << " fps, " << cameras.size()
-              << " cameras; live: lag " << options.lag << ", " << options.live_iterations
-              << " iterations; ground plane " << (options.ground ? "given" : "none")
-              << ", ankle clearance " << options.ankle_clearance_m << " m\n\n"
+    std::cout << truth.size() << " clips ("
+              << (args.has("eval-files") ? "files" : args.get("eval-split")) << "; first "
+              << args.get("max-frames") << " frames each), " << frames << " frames at " << fps
+              << " fps, " << cameras.size() << " cameras; live: lag " << options.lag << ", "
+              << options.live_iterations << " iterations; ground plane "
+              << (options.ground ? "given" : "none") << ", ankle clearance "
+              << options.ankle_clearance_m << " m\n\n"
               << "| method | condition | MPJPE mm | PA-MPJPE mm | accel mm/f² | root err mm | "
                  "skate cm/f | below floor cm | ankle-frames >1 cm below % | fit person-frames/s "
                  "|\n|---|---|---:|---:|---:|---:|---:|---:|---:|---:|\n";
@@ -221,6 +329,26 @@ int main(int argc, char** argv) {
         all.add(rows[{m, c.label()}]);
       }
       print_row(m, "all", all);
+    }
+    if (variants.size() > 1) {
+      std::cout << "\nWeight variants (rows \"all\": every condition; the base is the options "
+                   "given):\n\n| variant | full MPJPE mm | full PA-MPJPE mm | full root err mm | "
+                   "full skate cm/f | live MPJPE mm | live PA-MPJPE mm | live root err mm | live "
+                   "accel mm/f² |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+      for (const auto& v : variants) {
+        const std::string suffix = v.label.empty() ? "" : " [" + v.label + "]";
+        Row full, live;
+        for (const auto& c : conditions) {
+          full.add(rows[{methods[2] + suffix, c.label()}]);
+          live.add(rows[{methods[3] + suffix, c.label()}]);
+        }
+        std::cout << "| " << (v.label.empty() ? "base" : v.label) << " | " << std::fixed
+                  << std::setprecision(1) << full.pose.mpjpe() << " | " << full.pose.pa_mpjpe()
+                  << " | " << full.placement.root_error_mm() << " | " << std::setprecision(2)
+                  << full.placement.skate_cm() << " | " << std::setprecision(1) << live.pose.mpjpe()
+                  << " | " << live.pose.pa_mpjpe() << " | " << live.placement.root_error_mm()
+                  << " | " << live.pose.accel() << " |\n";
+      }
     }
     std::cout << "\nRetrieval: path + Savitzky-Golay (3, 11) + ray + view refinement on "
               << args.get("db") << ". Skating: horizontal ankle motion (world) between "
