@@ -275,14 +275,14 @@ struct LiveFitter::State {
 LiveFitter::LiveFitter(FitOptions options) : state_(std::make_unique<State>()) {
   state_->options = std::move(options);
   state_->options.lag = std::max(0, state_->options.lag);
+  if (state_->options.weights.live_prior_rad > 0)
+    state_->options.weights.prior_rad = state_->options.weights.live_prior_rad;
 }
 LiveFitter::~LiveFitter() = default;
 LiveFitter::LiveFitter(LiveFitter&&) noexcept = default;
 LiveFitter& LiveFitter::operator=(LiveFitter&&) noexcept = default;
 const BoneLengths& LiveFitter::bones() const { return state_->lengths; }
-void LiveFitter::set_ground(std::optional<GroundPlane> ground) {
-  state_->options.ground = ground;
-}
+void LiveFitter::set_ground(std::optional<GroundPlane> ground) { state_->options.ground = ground; }
 const FitStats& LiveFitter::stats() const { return state_->stats; }
 
 std::optional<FittedFrame> LiveFitter::push(const FrameInput& frame) {

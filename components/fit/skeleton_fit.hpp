@@ -73,6 +73,7 @@ struct FitWeights {
   double robust = 2.0;               // Huber threshold, in reprojection sigmas
   double min_confidence = 0.05;      // keypoints below are missing
   double prior_rad = 0.15;           // bone rotation away from the retrieved direction
+  double live_prior_rad = 0.0;       // the same in live mode (fixed bones); 0: prior_rad
   double translation_prior_m = 1.0;  // root away from its closed-form start (per axis)
   double bone_accel_m = 0.015;       // bone-vector acceleration (world), metres / frame²
   double root_accel_m = 0.01;        // root acceleration (world), metres / frame²
@@ -84,6 +85,7 @@ struct FitWeights {
   double body_scale = 0.01;          // the sum of the bones over its initial value, minus 1
   double slide_m = 0.005;            // a contact foot's motion between frames (world), metres
   double ground_m = 0.005;           // an ankle below the ground plus clearance, metres
+  double contact_ground_m = 0.0;     // a contact ankle above the ground plus clearance (0: free)
 };
 
 struct FitOptions {

@@ -169,12 +169,13 @@ struct SlideCost {
   }
 };
 
-// An ankle stays at least `clearance` above the ground. Params: t, bones, w chain.
+// An ankle stays at least `clearance` above the ground; a contact ankle, with `inv_above` > 0,
+// also no higher than that. Params: t, bones, w chain.
 struct GroundCost {
   const FrameData* data;
   Chain chain;
   GroundPlane plane;
-  double clearance, inv_sigma;
+  double clearance, inv_sigma, inv_above;
   template <typename T>
   bool operator()(T const* const* p, T* r) const {
     T c[3], w[3];
@@ -182,7 +183,7 @@ struct GroundCost {
     to_world(*data, c, w);
     const T height = T(plane.normal.x) * w[0] + T(plane.normal.y) * w[1] +
                      T(plane.normal.z) * w[2] + T(plane.offset);
-    r[0] = height < T(clearance) ? (T(clearance) - height) * T(inv_sigma) : T(0.0);
+    r[0] = (T(clearance) - height) * T(height < T(clearance) ? inv_sigma : inv_above);
     return true;
   }
 };
@@ -195,13 +196,16 @@ struct BonePriorCost {
     T total(0.0);
     double total0 = 0.0;
     for (int b = 0; b < kBones; ++b) {
-      r[b] = (bones[b] - T(initial[b])) * T(inv_sigma);
       total += bones[b];
       total0 += initial[b];
     }
-    // The overall size: monocular 2D cannot tell a larger person further away from a smaller
-    // one nearer, and the smoothness terms would shrink the body; the database's size is kept.
-    r[kBones + 6] = (total / T(total0) - T(1.0)) * T(inv_scale);
+    // Proportions and size apart: each bone is held near the initial skeleton scaled to the
+    // current overall size, and the size by its own term. Monocular 2D alone cannot tell a larger
+    // person further away from a smaller one nearer (the ground plane and contacts can), and the
+    // smoothness terms would shrink the body: `body_scale` says how far the size may move.
+    const T scale = total / T(total0);
+    for (int b = 0; b < kBones; ++b) r[b] = (bones[b] - scale * T(initial[b])) * T(inv_sigma);
+    r[kBones + 6] = (scale - T(1.0)) * T(inv_scale);
     constexpr std::array<std::array<int, 2>, 6> pairs = {
         {{2, 5}, {3, 6}, {4, 7}, {8, 11}, {9, 12}, {10, 13}}};
     for (int i = 0; i < 6; ++i)
@@ -304,10 +308,14 @@ WindowSummary solve_window(std::span<const WindowFrame> frames, Bones& bones,
           v.w[knee].data(), v.w[ankle].data());
     // Ground.
     if (options.ground) {
-      for (int foot : kFeet) {
+      for (int s = 0; s < 2; ++s) {
+        const int foot = kFeet[s];
+        const double inv_above =
+            d.contact[s] && wt.contact_ground_m > 0 ? 1.0 / wt.contact_ground_m : 0.0;
         auto cost = std::make_unique<Dynamic<GroundCost>>(
             std::make_unique<GroundCost>(GroundCost{&d, chains[foot], *options.ground,
-                                                    options.ankle_clearance_m, 1.0 / wt.ground_m})
+                                                    options.ankle_clearance_m, 1.0 / wt.ground_m,
+                                                    inv_above})
                 .release());
         std::vector<double*> blocks = {v.t.data(), bones.data()};
         cost->AddParameterBlock(3);

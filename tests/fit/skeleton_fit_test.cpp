@@ -317,3 +317,40 @@ TEST(SkeletonFit, LiveModeWithALagImprovesOnTheRetrievedPoses) {
 
 }  // namespace
 }  // namespace mocap
+
+namespace mocap {
+namespace {
+
+double bone_sum(const fit::BoneLengths& b) {
+  double sum = 0;
+  for (double m : b.m) sum += m;
+  return sum;
+}
+
+// The retrieved poses are the truth shrunk to 90 %: the 2D alone cannot see it (a smaller
+// person nearer fits the keypoints as well), the ground plane and the contact feet can. With the
+// size left free and contact ankles held on the ground, the fit finds the size again.
+TEST(SkeletonFit, FreeSizeFollowsTheGroundAndTheContactFeet) {
+  MOCAP_REQUIRE_FIT_CLIP();
+  const auto s = fit_scene(0, 72, 45.0f, 0.0f);
+  auto retrieved = test::perturbed_truth(s.rendered.truth_camera, 0.0f, 1);
+  for (auto& p : retrieved)
+    for (auto& j : p.joints) j *= 0.9f;
+  const auto contacts = fit::truth_contacts(s.world, test::kFitFps);
+  const auto inputs = fit::make_inputs(s.rendered.input, retrieved, contacts, s.cameras);
+  auto options = base_options();
+  options.ground = fit::GroundPlane{{0.0, 1.0, 0.0}, 0.0};
+  options.ankle_clearance_m = fit::ankle_floor(s.world);
+  const double truth = bone_sum(truth_bones(s.world));
+  const auto kept = fit::fit_sequence(inputs, options);
+  options.weights.body_scale = 1.0;
+  options.weights.contact_ground_m = 0.01;
+  const auto freed = fit::fit_sequence(inputs, options);
+  EXPECT_NEAR(bone_sum(kept.bones) / truth, 0.9, 0.02);
+  EXPECT_NEAR(bone_sum(freed.bones) / truth, 1.0, 0.03);
+  EXPECT_LT(test::mean_mpjpe_mm(freed.frames, s.rendered.truth_camera),
+            0.6 * test::mean_mpjpe_mm(kept.frames, s.rendered.truth_camera));
+}
+
+}  // namespace
+}  // namespace mocap

@@ -74,6 +74,7 @@ std::vector<std::string> split_commas(const std::string& text) {
 // A named weight of FitWeights that `--sweep NAME=V1,V2` may vary; nullptr when unknown.
 double* sweep_weight(fit::FitWeights& w, const std::string& name) {
   if (name == "prior") return &w.prior_rad;
+  if (name == "live-prior") return &w.live_prior_rad;
   if (name == "reprojection") return &w.reprojection;
   if (name == "bone-accel") return &w.bone_accel_m;
   if (name == "root-accel") return &w.root_accel_m;
@@ -84,6 +85,7 @@ double* sweep_weight(fit::FitWeights& w, const std::string& name) {
   if (name == "knee-limit") return &w.knee_limit;
   if (name == "slide") return &w.slide_m;
   if (name == "ground") return &w.ground_m;
+  if (name == "contact-ground") return &w.contact_ground_m;
   return nullptr;
 }
 
@@ -161,11 +163,12 @@ int main(int argc, char** argv) {
       .option("velocity", "M", "live lag 0: sigma of bone and root velocity, m/frame", "0.03")
       .option("translation-prior", "M", "sigma of the root from its closed-form start", "1.0")
       .option("bone-prior", "M", "full mode: sigma of a bone length from its initial value", "0.01")
-      .option("sweep", "NAME=V1,V2",
-              "also fit with each value of one weight (the others as given; retrieval shared); "
-              "names: prior reprojection bone-accel root-accel translation-prior bone-prior "
-              "symmetry body-scale knee-limit slide ground",
-              std::nullopt, true)
+      .option(
+          "sweep", "NAME=V1,V2",
+          "also fit with each value of one weight (the others as given; retrieval shared); "
+          "names: prior live-prior reprojection bone-accel root-accel translation-prior bone-prior "
+          "symmetry body-scale knee-limit slide ground contact-ground",
+          std::nullopt, true)
       .option("variant", "NAME=V,NAME=V", "also fit with these weights changed together",
               std::nullopt, true);
   int code = 0;
