@@ -196,16 +196,15 @@ struct BonePriorCost {
     T total(0.0);
     double total0 = 0.0;
     for (int b = 0; b < kBones; ++b) {
+      r[b] = (bones[b] - T(initial[b])) * T(inv_sigma);
       total += bones[b];
       total0 += initial[b];
     }
-    // Proportions and size apart: each bone is held near the initial skeleton scaled to the
-    // current overall size, and the size by its own term. Monocular 2D alone cannot tell a larger
-    // person further away from a smaller one nearer (the ground plane and contacts can), and the
-    // smoothness terms would shrink the body: `body_scale` says how far the size may move.
-    const T scale = total / T(total0);
-    for (int b = 0; b < kBones; ++b) r[b] = (bones[b] - scale * T(initial[b])) * T(inv_sigma);
-    r[kBones + 6] = (scale - T(1.0)) * T(inv_scale);
+    // The overall size: monocular 2D cannot tell a larger person further away from a smaller
+    // one nearer, and the smoothness terms would shrink the body; the database's size is kept.
+    // (Holding each bone near the initial one scaled to the current size instead was tried:
+    // better on validation, worse on the held-out clips; docs/fitting.md.)
+    r[kBones + 6] = (total / T(total0) - T(1.0)) * T(inv_scale);
     constexpr std::array<std::array<int, 2>, 6> pairs = {
         {{2, 5}, {3, 6}, {4, 7}, {8, 11}, {9, 12}, {10, 13}}};
     for (int i = 0; i < 6; ++i)
