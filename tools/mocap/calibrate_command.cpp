@@ -28,6 +28,7 @@
 #include "commands.hpp"
 #include "core/input_error.hpp"
 #include "eval/layout_calibration.hpp"
+#include "eval_report.hpp"
 
 namespace mocap::cli {
 namespace {
@@ -130,12 +131,6 @@ std::string proportions(std::span<const eval::CalibrationFrame> frames) {
     << fixed(mean_distance(joint(Joint::right_shoulder), joint(Joint::right_elbow)), 0) << " | "
     << fixed(mean_distance(joint(Joint::right_elbow), joint(Joint::right_wrist)), 0) << " |\n";
   return t.str();
-}
-
-std::string command_line(int argc, char** argv) {
-  std::string line = "mocap calibrate layout";
-  for (int i = 0; i < argc; ++i) line.append(" ").append(argv[i]);
-  return line;
 }
 
 constexpr const char* kModel =
@@ -249,8 +244,8 @@ int layout_command(int argc, char** argv) {
     std::string header = "Where " + std::string(lay->name) +
                          " puts its joints relative to the canonical joint centres.\n"
                          "Produced by: " +
-                         command_line(argc, argv) + "\nData: " + source + "\nModel: " + kModel +
-                         "\n\n" + report.str();
+                         command_line("mocap calibrate layout", argc, argv) + "\nData: " + source +
+                         "\nModel: " + kModel + "\n\n" + report.str();
     const fs::path out = args.get("out");
     if (out.has_parent_path()) fs::create_directories(out.parent_path());
     std::ofstream(out) << recon::format_layout_offsets(fit.offsets, header);

@@ -178,12 +178,6 @@ std::vector<std::optional<eval::Body>> world_poses(const ViewJob& job, const fit
   return out;
 }
 
-std::string command_line(int argc, char** argv) {
-  std::string line = "mocap eval crossview";
-  for (int i = 0; i < argc; ++i) line.append(" ").append(argv[i]);
-  return line;
-}
-
 }  // namespace
 
 int crossview_eval_command(int argc, char** argv) {
@@ -226,9 +220,10 @@ int crossview_eval_command(int argc, char** argv) {
 
   std::vector<ViewJob> jobs;
   std::vector<Group> groups;
-  json out = {{"protocol", "crossview"},    {"command", command_line(argc, argv)},
-              {"git_commit", git_commit()}, {"machine", machine_description()},
-              {"database", args.get("db")}, {"evaluation_fps", fps}};
+  json out = {
+      {"protocol", "crossview"},    {"command", command_line("mocap eval crossview", argc, argv)},
+      {"git_commit", git_commit()}, {"machine", machine_description()},
+      {"database", args.get("db")}, {"evaluation_fps", fps}};
   std::cout << "## Cross-view consistency (the paper's §5.3)\n\n";
   if (datasets.find("pose2sim") != std::string::npos)
     out["pose2sim_calibration_check"] = add_pose2sim(args.get("pose2sim"), args.get("calibration"),
@@ -373,10 +368,7 @@ int crossview_eval_command(int argc, char** argv) {
             << "; fit: full sequence, ground plane "
             << (fit_options.ground ? "world Z = 0" : "none") << ". The paper: 9.4 cm (135° apart) "
             << "and 6.8 cm (75°), VNect 16.4 and 15.2 cm.\n";
-  out["seconds"] =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-  std::ofstream(args.get("json")) << out.dump(2) << "\n";
-  std::cout << "\nAll numbers: " << args.get("json") << "\n";
+  write_results(out, args.get("json"), started);
   return 0;
 }
 

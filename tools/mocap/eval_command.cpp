@@ -300,10 +300,7 @@ int virtual_protocol(int argc, char** argv) {
       std::cout << sep << family << " " << n, sep = ", ";
     std::cout << ")\n";
   }
-  out["seconds"] =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-  std::ofstream(args.get("json")) << out.dump(2) << "\n";
-  std::cout << "\nAll numbers: " << args.get("json") << "\n";
+  write_results(out, args.get("json"), started);
   return 0;
 }
 

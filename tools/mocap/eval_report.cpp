@@ -5,6 +5,7 @@
 #include <array>
 #include <cstdio>
 #include <fstream>
+#include <iostream>
 #include <memory>
 #include <thread>
 
@@ -33,6 +34,20 @@ std::string git_commit() {
   std::string s(buf.data());
   while (!s.empty() && (s.back() == '\n' || s.back() == '\r')) s.pop_back();
   return s.empty() ? "unknown" : s;
+}
+
+std::string command_line(std::string_view program, int argc, char** argv) {
+  std::string line(program);
+  for (int i = 0; i < argc; ++i) line.append(" ").append(argv[i]);
+  return line;
+}
+
+void write_results(nlohmann::json& results, const std::string& path,
+                   std::chrono::steady_clock::time_point started) {
+  results["seconds"] =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  std::ofstream(path) << results.dump(2) << "\n";
+  std::cout << "\nAll numbers: " << path << "\n";
 }
 
 }  // namespace mocap::cli

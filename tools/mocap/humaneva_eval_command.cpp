@@ -265,12 +265,6 @@ json table_json(const eval::HumanEvaTable& table) {
           {"all_frames", scores_json(table.all())}};
 }
 
-std::string command_line(int argc, char** argv) {
-  std::string line = "mocap eval humaneva";
-  for (int i = 0; i < argc; ++i) line.append(" ").append(argv[i]);
-  return line;
-}
-
 constexpr const char* kRateNote =
     "HumanEva is 60 Hz, the databases 24 fps: the 2D input and the 3D truth are both resampled to "
     "the database rate by linear interpolation, noise is added per evaluated frame, and the "
@@ -465,7 +459,7 @@ int humaneva_eval_command(int argc, char** argv) {
   const auto rows = run_jobs(variants, conditions, sequences, threads);
 
   json out = {{"protocol", "humaneva"},
-              {"command", command_line(argc, argv)},
+              {"command", command_line("mocap eval humaneva", argc, argv)},
               {"git_commit", git_commit()},
               {"machine", machine_description()},
               {"data", folder},
@@ -485,10 +479,7 @@ int humaneva_eval_command(int argc, char** argv) {
   std::cout << "\nRate: " << kRateNote << ".\n\nConfigurations:\n";
   for (const auto& row : rows.front())
     std::cout << "- " << row.name << ": " << row.description << "\n";
-  out["seconds"] =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-  std::ofstream(args.get("json")) << out.dump(2) << "\n";
-  std::cout << "\nAll numbers: " << args.get("json") << "\n";
+  write_results(out, args.get("json"), started);
   return 0;
 }
 

@@ -74,12 +74,6 @@ json result_json(const Result& r) {
   return j;
 }
 
-std::string command_line(int argc, char** argv) {
-  std::string line = "mocap eval humaneva-fit";
-  for (int i = 0; i < argc; ++i) line.append(" ").append(argv[i]);
-  return line;
-}
-
 }  // namespace
 
 int humaneva_fit_command(int argc, char** argv) {
@@ -200,7 +194,7 @@ int humaneva_fit_command(int argc, char** argv) {
       "is that difference of definitions";
   std::cout << "\n" << note << ".\n";
   json out = {{"protocol", "humaneva-fit"},
-              {"command", command_line(argc, argv)},
+              {"command", command_line("mocap eval humaneva-fit", argc, argv)},
               {"git_commit", git_commit()},
               {"machine", machine_description()},
               {"database", args.get("db")},
@@ -214,10 +208,7 @@ int humaneva_fit_command(int argc, char** argv) {
               {"note", note},
               {"joint_correspondence", eval::humaneva_joint_correspondence()},
               {"results", table}};
-  out["seconds"] =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-  std::ofstream(args.get("json")) << out.dump(2) << "\n";
-  std::cout << "\nAll numbers: " << args.get("json") << "\n";
+  write_results(out, args.get("json"), started);
   return 0;
 }
 
