@@ -117,17 +117,6 @@ const std::array<std::vector<const char*>, kBodyJoints> kGenericNames = {{
     {},  // root: midpoint of the hips, filled in below
 }};
 
-std::string fold(std::string_view name) {
-  if (const auto colon = name.rfind(':'); colon != std::string_view::npos)
-    name.remove_prefix(colon + 1);
-  std::string out;
-  for (char c : name) {
-    if (std::isalnum(static_cast<unsigned char>(c)))
-      out.push_back(static_cast<char>(std::tolower(static_cast<unsigned char>(c))));
-  }
-  return out;
-}
-
 bool has_all(const Skeleton& s, std::initializer_list<const char*> names) {
   return std::all_of(names.begin(), names.end(), [&](const char* n) { return s.find(n) >= 0; });
 }
@@ -163,7 +152,7 @@ BodyMapping from_table(const Skeleton& s, const FamilyTable& table, Family famil
 int find_generic(const Skeleton& s, const std::vector<const char*>& names) {
   for (const char* wanted : names) {
     for (int j = 0; j < s.joint_count(); ++j) {
-      if (!s.joints[j].end_site && fold(s.joints[j].name) == wanted) return j;
+      if (!s.joints[j].end_site && fold_joint_name(s.joints[j].name) == wanted) return j;
     }
   }
   return -1;
@@ -215,6 +204,17 @@ BodyMapping generic_mapping(const Skeleton& s, const std::string& source) {
 }
 
 }  // namespace
+
+std::string fold_joint_name(std::string_view name) {
+  if (const auto colon = name.rfind(':'); colon != std::string_view::npos)
+    name.remove_prefix(colon + 1);
+  std::string out;
+  for (char c : name) {
+    if (std::isalnum(static_cast<unsigned char>(c)))
+      out.push_back(static_cast<char>(std::tolower(static_cast<unsigned char>(c))));
+  }
+  return out;
+}
 
 std::string_view family_name(Family f) {
   switch (f) {

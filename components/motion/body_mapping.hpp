@@ -19,6 +19,10 @@ enum class Family { cmu31, cmu_asf, cmu_daz, bandai, generic };
 
 std::string_view family_name(Family f);
 
+// A joint name as the name tables compare it: without a namespace prefix ("mixamorig:"), letters
+// and digits only, lower case ("Left_UpLeg" -> "leftupleg").
+std::string fold_joint_name(std::string_view name);
+
 // Where one body joint sits on a skeleton: at a joint, at the midpoint of two joints, and/or
 // displaced by an offset in the first joint's local frame (file units).
 struct BodyJointSource {

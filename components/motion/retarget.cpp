@@ -111,7 +111,7 @@ std::vector<ExtraRole> extra_roles(Family family) {
               {Role::left_toe, {"Toes_L"}},
               {Role::right_toe, {"Toes_R"}}};
     case Family::generic:
-      // Compared without case or separators (fold below).
+      // Compared without case or separators (fold_joint_name).
       return {
           {Role::pelvis, {"hips", "hip", "pelvis"}},
           {Role::spine, {"spine", "abdomen", "spine01", "spinelower"}},
@@ -127,21 +127,10 @@ std::vector<ExtraRole> extra_roles(Family family) {
   return {};
 }
 
-std::string fold(std::string_view name) {
-  if (const auto colon = name.rfind(':'); colon != std::string_view::npos)
-    name.remove_prefix(colon + 1);
-  std::string out;
-  for (char c : name) {
-    if (std::isalnum(static_cast<unsigned char>(c)))
-      out.push_back(static_cast<char>(std::tolower(static_cast<unsigned char>(c))));
-  }
-  return out;
-}
-
 int find_joint(const Skeleton& s, const char* name, bool folded) {
   for (int j = 0; j < s.joint_count(); ++j) {
     if (s.joints[j].end_site) continue;
-    if (folded ? fold(s.joints[j].name) == name : s.joints[j].name == name) return j;
+    if (folded ? fold_joint_name(s.joints[j].name) == name : s.joints[j].name == name) return j;
   }
   return -1;
 }
