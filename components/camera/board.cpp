@@ -7,9 +7,12 @@
 
 #include <opencv2/aruco/charuco.hpp>
 #include <opencv2/calib3d.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
 
 #include "camera/board_detection.hpp"
+#include "core/input_error.hpp"
 
 namespace mocap::camera {
 namespace {
@@ -175,6 +178,34 @@ BoardDetection detect_board(const cv::Mat& gray, const BoardSpec& board, int min
   check_board(board);
   if (board.kind == BoardKind::chessboard) return detect_chessboard(gray, board);
   return detect_charuco(gray, board, min_corners, K, D);
+}
+
+}  // namespace detail
+namespace detail {
+
+std::string for_each_image(const std::vector<std::string>& files, const ViewSink& add) {
+  for (const std::string& file : files) {
+    cv::Mat image;
+    try {
+      image = cv::imread(file, cv::IMREAD_COLOR);
+    } catch (const cv::Exception&) {
+      image = cv::Mat();
+    }
+    add(file, image);
+  }
+  return files.size() == 1 ? files.front() : std::to_string(files.size()) + " images";
+}
+
+void for_each_video_frame(const std::string& video, int step, const ViewSink& add) {
+  cv::VideoCapture capture;
+  try {
+    capture.open(video);
+  } catch (const cv::Exception&) {
+  }
+  if (!capture.isOpened()) throw InputError(video, "cannot open the video");
+  cv::Mat frame;
+  for (long index = 0; capture.read(frame); ++index)
+    if (index % step == 0) add(video + "#" + std::to_string(index), frame);
 }
 
 }  // namespace detail

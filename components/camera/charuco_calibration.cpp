@@ -4,8 +4,6 @@
 #include <utility>
 
 #include <opencv2/aruco/charuco.hpp>
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/videoio.hpp>
 
 #include "camera/board_detection.hpp"
 #include "core/input_error.hpp"
@@ -77,31 +75,17 @@ BoardCalibration calibrate_charuco_images(const std::vector<std::string>& images
                                           const CharucoOptions& options) {
   check(options);
   Collector collector(options);
-  for (const std::string& file : images) {
-    cv::Mat image;
-    try {
-      image = cv::imread(file, cv::IMREAD_COLOR);
-    } catch (const cv::Exception&) {
-      image = cv::Mat();
-    }
-    collector.add(file, image);
-  }
-  return collector.finish(images.size() == 1 ? images.front()
-                                             : std::to_string(images.size()) + " images");
+  const std::string name = detail::for_each_image(
+      images, [&](const std::string& view, const cv::Mat& image) { collector.add(view, image); });
+  return collector.finish(name);
 }
 
 BoardCalibration calibrate_charuco_video(const std::string& video, const CharucoOptions& options) {
   check(options);
-  cv::VideoCapture capture;
-  try {
-    capture.open(video);
-  } catch (const cv::Exception&) {
-  }
-  if (!capture.isOpened()) throw InputError(video, "cannot open the video");
   Collector collector(options);
-  cv::Mat frame;
-  for (long index = 0; capture.read(frame); ++index)
-    if (index % options.video_step == 0) collector.add(video + "#" + std::to_string(index), frame);
+  detail::for_each_video_frame(
+      video, options.video_step,
+      [&](const std::string& view, const cv::Mat& frame) { collector.add(view, frame); });
   return collector.finish(video);
 }
 

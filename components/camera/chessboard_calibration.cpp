@@ -3,10 +3,9 @@
 #include <stdexcept>
 
 #include <opencv2/calib3d.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
-#include <opencv2/videoio.hpp>
 
+#include "camera/board_detection.hpp"
 #include "core/input_error.hpp"
 
 namespace mocap::camera {
@@ -92,32 +91,18 @@ ChessboardCalibration calibrate_chessboard_images(const std::vector<std::string>
                                                   const ChessboardOptions& options) {
   check(options);
   Collector collector(options);
-  for (const std::string& file : images) {
-    cv::Mat image;
-    try {
-      image = cv::imread(file, cv::IMREAD_COLOR);
-    } catch (const cv::Exception&) {
-      image = cv::Mat();
-    }
-    collector.add(file, image);
-  }
-  return collector.finish(images.size() == 1 ? images.front()
-                                             : std::to_string(images.size()) + " images");
+  const std::string name = detail::for_each_image(
+      images, [&](const std::string& view, const cv::Mat& image) { collector.add(view, image); });
+  return collector.finish(name);
 }
 
 ChessboardCalibration calibrate_chessboard_video(const std::string& video,
                                                  const ChessboardOptions& options) {
   check(options);
-  cv::VideoCapture capture;
-  try {
-    capture.open(video);
-  } catch (const cv::Exception&) {
-  }
-  if (!capture.isOpened()) throw InputError(video, "cannot open the video");
   Collector collector(options);
-  cv::Mat frame;
-  for (long index = 0; capture.read(frame); ++index)
-    if (index % options.video_step == 0) collector.add(video + "#" + std::to_string(index), frame);
+  detail::for_each_video_frame(
+      video, options.video_step,
+      [&](const std::string& view, const cv::Mat& frame) { collector.add(view, frame); });
   return collector.finish(video);
 }
 
