@@ -16,11 +16,11 @@
 #include <optional>
 
 #include "camera/camera_file.hpp"
-#include "camera/undistortion.hpp"
 #include "fit/foot_contact.hpp"
 #include "fit/ground_estimation.hpp"
 #include "fit/skeleton_fit.hpp"
 #include "graph/registry.hpp"
+#include "nodes/recon/node_camera.hpp"
 #include "posedb/database.hpp"
 
 namespace mocap::nodes {
@@ -41,14 +41,7 @@ class FitNode : public Node {
     c.param<int>("iterations", 8, "live: solver iterations per frame", {1, 100});
     c.param<int>("max_missed", 10, "frames a person may be missing before their fit ends",
                  {0, 10000});
-    c.param<int>("image_width", 0, "input image width in pixels (with hfov_deg: the camera)",
-                 {0, 100000});
-    c.param<int>("image_height", 0, "input image height in pixels", {0, 100000});
-    c.param<double>("hfov_deg", 60.0, "horizontal field of view assumed without a camera file",
-                    {1.0, 179.0});
-    c.param<std::string>("camera", "",
-                         "calibrated camera file (OpenCV YAML): intrinsics, distortion (every "
-                         "keypoint is undistorted) and, when present, the floor");
+    declare_camera_params(c);  // a camera file's floor is used too (ground: auto)
     c.param<std::string>("ground", "auto",
                          "auto (the camera file's floor, else estimated from the feet), feet "
                          "(always estimated) or off (no floor)");
@@ -135,28 +128,23 @@ class FitNode : public Node {
   };
 
   void open_camera(Context& ctx) {
-    const int width = ctx.param<int>("image_width"), height = ctx.param<int>("image_height");
-    if (const std::string file = ctx.param<std::string>("camera"); !file.empty()) {
-      lens_ = camera::read_camera_file(file);
-      options_.camera = {static_cast<float>(lens_->fx()), static_cast<float>(lens_->fy()),
-                         static_cast<float>(lens_->cx()), static_cast<float>(lens_->cy())};
-      if (ground_mode_ == "auto") {
-        if (const auto plane = camera::read_ground_plane(file)) {
-          set_ground({glm::vec3(glm::dvec3(plane->normal[0], plane->normal[1], plane->normal[2])),
-                      static_cast<float>(plane->offset)},
-                     "calibrated");
-        }
-      }
-      return;
-    }
-    if (width <= 0 || height <= 0)
+    camera_ = read_camera_params(ctx);
+    if (!camera_.pinhole.valid())
       throw std::invalid_argument(
           "the fitting needs the camera: set 'camera' (a calibration file) or 'image_width' and "
           "'image_height' (with 'hfov_deg')");
-    options_.camera = recon::Pinhole::from_fov(width, height, ctx.param<float>("hfov_deg"));
-    std::cerr << "recon.fit '" << ctx.node_name() << "': no camera file, assuming a pinhole of "
-              << ctx.param<double>("hfov_deg") << " deg horizontal field of view, principal point "
-              << "at the image centre, no distortion\n";
+    options_.camera = camera_.pinhole;
+    if (camera_.assumed) {
+      std::cerr << "recon.fit '" << ctx.node_name() << "': no camera file, assuming a pinhole of "
+                << camera_.hfov_deg << " deg horizontal field of view, principal point at the "
+                << "image centre, no distortion\n";
+    } else if (ground_mode_ == "auto") {
+      if (const auto plane = camera::read_ground_plane(ctx.param<std::string>("camera"))) {
+        set_ground({glm::vec3(glm::dvec3(plane->normal[0], plane->normal[1], plane->normal[2])),
+                    static_cast<float>(plane->offset)},
+                   "calibrated");
+      }
+    }
   }
 
   void start(Track& track, std::int64_t t) {
@@ -167,14 +155,13 @@ class FitNode : public Node {
 
   fit::FrameInput frame_input(const Person3D& person) const {
     fit::FrameInput in;
+    std::array<Keypoint2D, kBodyJoints> keypoints = person.keypoints;
+    undistort(camera_, keypoints);
     for (int j = 0; j < kBodyJoints; ++j) {
-      const Keypoint2D& k = person.keypoints[static_cast<std::size_t>(j)];
-      float x = k.x, y = k.y;
-      if (lens_ && k.confidence > 0)
-        std::tie(x, y) = as_pair(camera::undistort_pixel(*lens_, x, y));
+      const auto [x, y, confidence] = keypoints[static_cast<std::size_t>(j)];
       in.keypoints[static_cast<std::size_t>(3 * j)] = x;
       in.keypoints[static_cast<std::size_t>(3 * j + 1)] = y;
-      in.keypoints[static_cast<std::size_t>(3 * j + 2)] = std::isfinite(x + y) ? k.confidence : 0;
+      in.keypoints[static_cast<std::size_t>(3 * j + 2)] = std::isfinite(x + y) ? confidence : 0;
     }
     in.retrieved_valid = true;
     in.retrieved = person.positions;
@@ -183,7 +170,6 @@ class FitNode : public Node {
       in.contact = contacts_->contact(static_cast<std::uint32_t>(person.provenance.frame));
     return in;
   }
-  static std::pair<float, float> as_pair(std::array<float, 2> a) { return {a[0], a[1]}; }
 
   // One frame of a track: the person as seen, or nullopt (absent: a gap in their window).
   void push(Track& track, int id, const std::optional<Person3D>& person) {
@@ -292,7 +278,7 @@ class FitNode : public Node {
 
   std::optional<posedb::Database> db_;
   std::optional<fit::ContactDetector> contacts_;
-  std::optional<camera::CameraIntrinsics> lens_;
+  NodeCamera camera_;
   fit::FitOptions options_;
   bool off_ = false, full_ = false;
   bool use_contact_ = true;

@@ -7,10 +7,10 @@
 #include <map>
 #include <optional>
 
-#include "camera/camera_file.hpp"
 #include "camera/undistortion.hpp"
 #include "core/input_error.hpp"
 #include "graph/registry.hpp"
+#include "nodes/recon/node_camera.hpp"
 #include "posedb/database.hpp"
 #include "recon/sequence_reconstruction.hpp"
 #include "recon/temporal_selector.hpp"
@@ -48,17 +48,7 @@ class TemporalSelectorNode : public Node {
     c.param<double>("data_weight", 50.0, "path: weight of the 2D match distance", {0.0, 1e6});
     c.param<int>("max_missed", 10, "frames a person may be missing before its state is dropped",
                  {0, 10000});
-    c.param<int>(
-        "image_width", 0,
-        "input image width in pixels; with the height, turns each pose onto the ray through "
-        "its root pixel (0: off)",
-        {0, 100000});
-    c.param<int>("image_height", 0, "input image height in pixels", {0, 100000});
-    c.param<double>("hfov_deg", 60.0, "horizontal field of view assumed for the camera",
-                    {1.0, 179.0});
-    c.param<std::string>("camera", "",
-                         "calibrated camera file (OpenCV YAML, `mocap calibrate intrinsics`): "
-                         "its matrix and distortion replace image_width/height and hfov_deg");
+    declare_camera_params(c);
   }
 
   void open(Context& ctx) override {
@@ -74,18 +64,7 @@ class TemporalSelectorNode : public Node {
     path_.data_weight = ctx.param<float>("data_weight");
     lag_ = mode_ == "path" ? ctx.param<int>("lag") : 0;
     max_missed_ = ctx.param<int>("max_missed");
-    const int width = ctx.param<int>("image_width"), height = ctx.param<int>("image_height");
-    if (const std::string file = ctx.param<std::string>("camera"); !file.empty()) {
-      lens_ = camera::read_camera_file(file);
-      if (width > 0 && height > 0 && (width != lens_->width || height != lens_->height))
-        throw InputError(file, "is a camera of " + std::to_string(lens_->width) + "x" +
-                                   std::to_string(lens_->height) + " pixels, the input is " +
-                                   std::to_string(width) + "x" + std::to_string(height));
-      camera_ = {static_cast<float>(lens_->fx()), static_cast<float>(lens_->fy()),
-                 static_cast<float>(lens_->cx()), static_cast<float>(lens_->cy())};
-    } else if (width > 0 && height > 0) {
-      camera_ = recon::Pinhole::from_fov(width, height, ctx.param<float>("hfov_deg"));
-    }
+    camera_ = read_camera_params(ctx);
   }
 
   void process(Context& ctx) override {
@@ -95,13 +74,12 @@ class TemporalSelectorNode : public Node {
     for (const PersonMatch& person : in.people) {
       if (person.id < 0) continue;  // untracked: no history to choose with
       pending_.back().keypoints[person.id] = person.body;
-      const Keypoint2D& root = person.body[index(Joint::root)];
-      if (lens_) {
-        const auto [x, y] = camera::undistort_pixel(*lens_, root.x, root.y);
-        pending_.back().root_pixel[person.id] = {x, y};
-      } else {
-        pending_.back().root_pixel[person.id] = {root.x, root.y};
+      Keypoint2D root = person.body[index(Joint::root)];
+      if (camera_.lens) {
+        const auto [x, y] = camera::undistort_pixel(*camera_.lens, root.x, root.y);
+        root.x = x, root.y = y;
       }
+      pending_.back().root_pixel[person.id] = {root.x, root.y};
       if (person.normalized_ok) {
         posedb::PoseVector query;
         std::copy(person.normalized.begin(), person.normalized.end(), query.begin());
@@ -193,8 +171,8 @@ class TemporalSelectorNode : public Node {
       turned = recon::refined_pose_in_camera(*db_, pose.chosen, query->second);
     }
     if (const auto root = pending.root_pixel.find(id);
-        camera_.valid() && root != pending.root_pixel.end()) {
-      recon::turn_onto_ray(turned, camera_, root->second);
+        camera_.pinhole.valid() && root != pending.root_pixel.end()) {
+      recon::turn_onto_ray(turned, camera_.pinhole, root->second);
     }
     pending.people.push_back(to_person(id, turned, *db_));
     if (const auto body = pending.keypoints.find(id); body != pending.keypoints.end())
@@ -222,8 +200,7 @@ class TemporalSelectorNode : public Node {
   recon::PathOptions path_;
   int lag_ = 0;
   int max_missed_ = 10;
-  recon::Pinhole camera_;  // invalid: poses stay as the database cameras see them
-  std::optional<camera::CameraIntrinsics> lens_;  // from a camera file: its distortion too
+  NodeCamera camera_;  // pinhole invalid: poses stay as the database cameras see them
   bool refine_view_ = true;
   std::map<int, Track> tracks_;
   std::deque<PendingFrame> pending_;
