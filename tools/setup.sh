@@ -47,6 +47,11 @@ packages=(
   blender                                               # a real BVH importer for the tests
   libaravis-dev aravis-tools libusb-1.0-0-dev           # GigE/USB3 Vision (aravis-0.8.pc needs libusb's .pc); fake camera
   clang-format                                          # code style
+  clang libclang-rt-14-dev                              # libFuzzer targets and sanitizer runtimes (tools/fuzz.sh)
+  libwebsocketpp-dev libasio-dev                        # the web viewer's HTTP + WebSocket server (sink.web)
+  libtinygltf-dev                                       # glTF 2.0 export (sink.gltf, mocap export)
+  liblo-dev liblo-tools                                 # OSC for the VMC live link (sink.vmc); oscdump in its tests
+  chromium                                              # a real browser for the viewer's tests (headless)
 )
 
 # npm fetches the detector model; a Node.js from elsewhere (e.g. NodeSource) brings its own npm.
@@ -125,10 +130,33 @@ if (( install )); then
   fi
 fi
 
+# three.js (served by the viewer), playwright-core (drives Debian's chromium in the tests) and the
+# glTF validator, pinned in tools/npm/package-lock.json, installed with `npm ci` into a cache outside
+# the repository. Skipped when the cache already holds exactly that lock file.
+npm_dir="${MOCAP_NPM_DIR:-${XDG_CACHE_HOME:-$HOME/.cache}/mocap/npm}"
+fetch_web_tools() (
+  if cmp -s "$repo/tools/npm/package-lock.json" "$npm_dir/package-lock.json" &&
+     [[ -d "$npm_dir/node_modules/three" ]]; then
+    log "web tools (three.js, playwright-core, gltf-validator) present in $npm_dir"
+    exit 0
+  fi
+  command -v npm >/dev/null || { echo "setup.sh: npm is needed to fetch the web tools" >&2; exit 1; }
+  mkdir -p "$npm_dir" && cp "$repo/tools/npm/package.json" "$repo/tools/npm/package-lock.json" \
+    "$npm_dir/" || exit 1
+  log "fetching three.js, playwright-core and gltf-validator from the npm registry into $npm_dir"
+  (cd "$npm_dir" && npm ci --silent --no-audit --no-fund >/dev/null) || {
+    rm -f "$npm_dir/package-lock.json"  # so that the next run tries again
+    echo "setup.sh: 'npm ci' in $npm_dir failed (network or registry)" >&2
+    exit 1
+  }
+)
+
 # Without the model everything else still builds and works (its tests skip), so a failed fetch
 # (e.g. no network) only warns here; --models-only fails on it.
 fetch_model || log "warning: the MoveNet model was not fetched; the detector and its tests need" \
   "it: run tools/setup.sh --models-only"
+fetch_web_tools || log "warning: the web tools were not fetched; the viewer page, its browser test" \
+  "and the glTF validator test need them (they skip without)"
 
 jobs=$(nproc 2>/dev/null || echo 2)
 if [[ ! -f "$build_dir/build.ninja" ]]; then
