@@ -17,5 +17,6 @@ int reconstruct_command(int argc, char** argv);
 int camera_command(int argc, char** argv);
 int calibrate_command(int argc, char** argv);
 int retarget_command(int argc, char** argv);
+int export_command(int argc, char** argv);
 
 }  // namespace mocap::cli
