@@ -1,0 +1,52 @@
+#pragma once
+// The viewer's messages: People3D -> one compact JSON text per frame (docs/viewer.md):
+//   {"type":"frame","frame":12,"time":0.48,
+//    "people":[{"id":3,"placed":false,"joints":[x,y,z, ...15 joints, millimetres],
+//               "keypoints":[x,y,c, ...15 joints, pixels and confidence]}],
+//    "ground":{"known":true,"normal":[x,y,z],"offset":1.52},
+//    "camera":{"known":true,"assumed":false,"width":640,"height":480,"fx":..,"fy":..,"cx":..,"cy":..},
+//    "playback":{"index":5,"count":795,"playing":true,"speed":1,"duration":26.5}}   (recordings)
+// Joints are absolute camera-frame positions (x right, y down, z forward): a placed person's own,
+// an unplaced (root-relative) person's shifted to a display spot (display_root) so that everyone
+// stands on the floor in a row in front of the camera.
+
+#include <cstddef>
+#include <optional>
+#include <string>
+
+#include <glm/vec3.hpp>
+
+#include "core/messages.hpp"
+
+namespace mocap::web {
+
+// The camera's intrinsics, when known; the page draws its frustum from them.
+struct CameraView {
+  bool known = false;
+  bool assumed = false;  // from a field of view, not calibrated
+  int width = 0, height = 0;
+  float fx = 0, fy = 0, cx = 0, cy = 0;
+};
+
+struct Playback {
+  std::size_t index = 0, count = 0;
+  bool playing = true;
+  double speed = 1.0;
+  double duration = 0.0;  // seconds
+};
+
+// Where the viewer stands the floor when it is not known: level, 1.5 m below the camera.
+GroundPlane assumed_ground();
+
+// Where the root of the `slot`-th of `count` unplaced people is drawn: 3 m in front of the camera,
+// 0.8 m apart left to right, hips 0.95 m above `ground` (the known floor or assumed_ground()).
+glm::vec3 display_root(const GroundPlane& ground, std::size_t slot, std::size_t count);
+
+// The greeting each browser gets first: joint names and the bones (pairs of joint indices).
+std::string hello_json(const std::string& title);
+
+std::string frame_json(const People3D& frame, const CameraView& camera,
+                       const std::optional<Playback>& playback = std::nullopt,
+                       std::optional<double> time = std::nullopt);
+
+}  // namespace mocap::web

@@ -1,0 +1,145 @@
+#include "web/recording.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+
+#include <nlohmann/json.hpp>
+
+#include "core/input_error.hpp"
+
+namespace mocap::web {
+namespace {
+
+using Json = nlohmann::json;
+
+glm::vec3 vec3_of(const Json& value, const std::string& what) {
+  if (!value.is_array() || value.size() != 3 || !value[0].is_number() || !value[1].is_number() ||
+      !value[2].is_number())
+    throw std::invalid_argument(what + " is not [x, y, z]");
+  return {value[0].get<float>(), value[1].get<float>(), value[2].get<float>()};
+}
+
+std::array<glm::vec3, kBodyJoints> joints_of(const Json& joints, const std::string& what) {
+  if (!joints.is_object()) throw std::invalid_argument(what + " is not an object");
+  std::array<glm::vec3, kBodyJoints> out{};
+  for (int j = 0; j < kBodyJoints; ++j) {
+    const std::string name(kJointNames[static_cast<std::size_t>(j)]);
+    const auto it = joints.find(name);
+    if (it == joints.end()) throw std::invalid_argument(what + " has no joint '" + name + "'");
+    out[static_cast<std::size_t>(j)] = vec3_of(*it, what + "." + name);
+  }
+  return out;
+}
+
+People3D frame_of(const Json& line, std::int64_t number) {
+  if (!line.is_object()) throw std::invalid_argument("not a JSON object");
+  People3D frame;
+  const auto f = line.find("frame");
+  frame.header.frame = f != line.end() && f->is_number_integer() ? f->get<std::int64_t>() : number;
+  frame.header.seq = static_cast<std::uint64_t>(number);
+  const auto people = line.find("people");
+  if (people == line.end() || !people->is_array()) throw std::invalid_argument("no 'people' array");
+  for (const Json& p : *people) {
+    Person3D person;
+    if (!p.is_object() || !p.contains("id") || !p["id"].is_number_integer())
+      throw std::invalid_argument("a person without an integer 'id'");
+    person.id = p["id"].get<int>();
+    const std::string what = "person " + std::to_string(person.id);
+    person.positions = joints_of(p.value("joints", Json()), what + " joints");
+    if (const auto abs = p.find("joints_abs"); abs != p.end()) {
+      const auto placed = joints_of(*abs, what + " joints_abs");
+      person.placed = true;
+      person.root.translation = placed[index(Joint::root)] - person.positions[index(Joint::root)];
+    }
+    frame.people.push_back(person);
+  }
+  if (const auto ground = line.find("ground"); ground != line.end()) {
+    if (!ground->is_object() || !ground->contains("offset") || !(*ground)["offset"].is_number())
+      throw std::invalid_argument("'ground' without a numeric 'offset'");
+    frame.ground.normal = vec3_of(ground->value("normal", Json()), "ground normal");
+    frame.ground.offset = (*ground)["offset"].get<float>();
+    const float length = std::sqrt(glm::dot(frame.ground.normal, frame.ground.normal));
+    if (!(length > 0.5f && length < 2.0f)) throw std::invalid_argument("ground normal not a unit");
+    frame.has_ground = true;
+  }
+  return frame;
+}
+
+}  // namespace
+
+Recording read_poses_jsonl(const std::string& path, double fps) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path, "cannot open the file");
+  Recording out;
+  bool times_ok = true;
+  std::string text;
+  for (long line = 1; std::getline(in, text); ++line) {
+    if (text.find_first_not_of(" \t\r") == std::string::npos) continue;
+    try {
+      const Json json = Json::parse(text);
+      out.frames.push_back(frame_of(json, static_cast<std::int64_t>(out.frames.size())));
+      const auto t = json.find("time");
+      const bool has_time = t != json.end() && t->is_number() && std::isfinite(t->get<double>());
+      const double time = has_time ? t->get<double>() : 0.0;
+      if (!has_time || (!out.times.empty() && time < out.times.back())) times_ok = false;
+      out.times.push_back(time);
+    } catch (const std::exception& e) {
+      throw InputError(path, line, std::string("not a poses.jsonl line: ") + e.what());
+    }
+  }
+  if (in.bad()) throw InputError(path, "read error");
+  if (out.frames.empty()) throw InputError(path, "no frames (an empty poses.jsonl)");
+  const double first = out.times.front();
+  for (std::size_t i = 0; i < out.times.size(); ++i) {
+    out.times[i] = times_ok ? out.times[i] - first : static_cast<double>(i) / fps;
+    out.frames[i].header.capture_ns = static_cast<std::int64_t>(std::llround(out.times[i] * 1e9));
+  }
+  return out;
+}
+
+Player::Player(std::vector<double> times) : times_(std::move(times)) {}
+
+void Player::seek(std::size_t index) {
+  if (times_.empty()) return;
+  index_ = std::min(index, times_.size() - 1);
+  clock_ = times_[index_];
+}
+
+void Player::set_speed(double speed) {
+  if (std::isfinite(speed)) speed_ = std::clamp(speed, 0.05, 16.0);
+}
+
+std::size_t Player::advance(double seconds) {
+  if (times_.size() < 2 || !playing_ || !(seconds > 0)) return index_;
+  // The last frame is shown for one mean frame interval before the recording starts again.
+  const double period =
+      duration() * static_cast<double>(times_.size()) / static_cast<double>(times_.size() - 1);
+  clock_ += seconds * speed_;
+  if (period > 0 && clock_ >= period) clock_ = std::fmod(clock_, period);
+  const auto after = std::upper_bound(times_.begin(), times_.end(), clock_);
+  index_ = static_cast<std::size_t>(std::max<std::ptrdiff_t>(0, after - times_.begin() - 1));
+  return index_;
+}
+
+bool Player::apply(const std::string& message) {
+  const Json json = Json::parse(message, nullptr, false);
+  if (!json.is_object() || !json.contains("cmd") || !json["cmd"].is_string()) return false;
+  const std::string cmd = json["cmd"].get<std::string>();
+  if (cmd == "play") {
+    play();
+  } else if (cmd == "pause") {
+    pause();
+  } else if (cmd == "seek" && json.contains("index") && json["index"].is_number()) {
+    const double i = json["index"].get<double>();
+    if (!std::isfinite(i)) return false;
+    seek(static_cast<std::size_t>(std::clamp(i, 0.0, 1e12)));
+  } else if (cmd == "speed" && json.contains("value") && json["value"].is_number()) {
+    set_speed(json["value"].get<double>());
+  } else {
+    return false;
+  }
+  return true;
+}
+
+}  // namespace mocap::web

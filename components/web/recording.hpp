@@ -1,0 +1,51 @@
+#pragma once
+// A recorded run for the viewer: poses.jsonl (sink.jsonl) read back into People3D frames, and the
+// playback clock the page controls (play, pause, seek, speed), looping at the end.
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "core/messages.hpp"
+
+namespace mocap::web {
+
+struct Recording {
+  std::vector<People3D> frames;
+  std::vector<double> times;  // seconds from the first frame, non-decreasing
+};
+
+// Reads poses.jsonl. People with `joints_abs` come back placed (root translation set), `ground`
+// sets the floor. Without usable times (missing, or going backwards) frames are `fps` apart.
+// Throws mocap::InputError naming the file and line for anything it cannot read, or an empty file.
+Recording read_poses_jsonl(const std::string& path, double fps = 30.0);
+
+class Player {
+ public:
+  explicit Player(std::vector<double> times);
+
+  void play() { playing_ = true; }
+  void pause() { playing_ = false; }
+  void seek(std::size_t index);
+  void set_speed(double speed);  // clamped to [0.05, 16]
+  // Moves the clock on by `seconds` of wall time (when playing) and returns the frame to show.
+  std::size_t advance(double seconds);
+  // A control message from the page: {"cmd":"play"}, {"cmd":"pause"}, {"cmd":"seek","index":N},
+  // {"cmd":"speed","value":S}. False (and nothing changes) when it is not one of them.
+  bool apply(const std::string& message);
+
+  std::size_t index() const { return index_; }
+  std::size_t count() const { return times_.size(); }
+  bool playing() const { return playing_; }
+  double speed() const { return speed_; }
+  double duration() const { return times_.empty() ? 0.0 : times_.back(); }
+
+ private:
+  std::vector<double> times_;
+  double clock_ = 0.0;
+  std::size_t index_ = 0;
+  bool playing_ = true;
+  double speed_ = 1.0;
+};
+
+}  // namespace mocap::web
