@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <numbers>
 #include <stdexcept>
 
@@ -44,15 +45,35 @@ cv::Mat read_matrix(const cv::FileStorage& fs, const std::string& path, const st
   return d;
 }
 
-void open_for_reading(cv::FileStorage& fs, const std::string& path) {
+// Camera files are a few hundred bytes; anything beyond this is not one.
+constexpr std::uintmax_t kMaxCameraFileBytes = 1u << 20;
+
+std::string read_camera_text(const std::string& path) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) throw InputError(path, "no such file");
-  if (std::filesystem::file_size(path, ec) == 0 || ec) throw InputError(path, "empty file");
+  const std::uintmax_t size = std::filesystem::file_size(path, ec);
+  if (ec || size == 0) throw InputError(path, "empty file");
+  if (size > kMaxCameraFileBytes)
+    throw InputError(path, "too large for a camera file (" + std::to_string(size) + " bytes)");
+  std::ifstream in(path, std::ios::binary);
+  std::string text(static_cast<std::size_t>(size), '\0');
+  if (!in.read(text.data(), static_cast<std::streamsize>(text.size())))
+    throw InputError(path, "read error");
+  return text;
+}
+
+void open_text(cv::FileStorage& fs, std::string_view text, const std::string& name) {
+  if (text.find_first_not_of(" \t\r\n") == std::string_view::npos)
+    throw InputError(name, "empty file");
+  if (text.size() > kMaxCameraFileBytes) throw InputError(name, "too large for a camera file");
+  // OpenCV reads C strings: text with a NUL byte would be cut there, so it is refused whole.
+  if (text.find('\0') != std::string_view::npos)
+    throw InputError(name, "not a text file (NUL byte)");
   try {
-    if (!fs.open(path, cv::FileStorage::READ))
-      throw InputError(path, "not an OpenCV YAML/XML/JSON file");
+    if (!fs.open(std::string(text), cv::FileStorage::READ | cv::FileStorage::MEMORY))
+      throw InputError(name, "not an OpenCV YAML/XML/JSON file");
   } catch (const cv::Exception& e) {
-    throw InputError(path, "not a readable OpenCV YAML file (" + e.err + ")");
+    throw InputError(name, "not a readable OpenCV YAML file (" + e.err + ")");
   }
 }
 
@@ -80,8 +101,12 @@ double camera_tilt_deg(const GroundPlane& plane) {
 }
 
 std::optional<GroundPlane> read_ground_plane(const std::string& path) {
+  return parse_ground_plane(read_camera_text(path), path);
+}
+
+std::optional<GroundPlane> parse_ground_plane(std::string_view text, const std::string& path) {
   cv::FileStorage fs;
-  open_for_reading(fs, path);
+  open_text(fs, text, path);
   const auto present = [&](const char* key) {
     const cv::FileNode node = fs[key];
     return !node.empty() && !node.isNone();
@@ -117,7 +142,7 @@ void write_ground_plane(const std::string& path, const GroundPlane& plane) {
   double rms = -1.0;
   {
     cv::FileStorage fs;
-    open_for_reading(fs, path);
+    open_text(fs, read_camera_text(path), path);
     const cv::FileNode node = fs["avg_reprojection_error"];
     if (node.isReal() || node.isInt()) rms = static_cast<double>(node);
     if (!std::isfinite(rms) || rms < 0) rms = -1.0;
@@ -148,8 +173,12 @@ CameraIntrinsics from_fov(int width, int height, double hfov_deg) {
 }
 
 CameraIntrinsics read_camera_file(const std::string& path) {
+  return parse_camera_file(read_camera_text(path), path);
+}
+
+CameraIntrinsics parse_camera_file(std::string_view text, const std::string& path) {
   cv::FileStorage fs;
-  open_for_reading(fs, path);
+  open_text(fs, text, path);
   CameraIntrinsics c;
   try {
     c.width = read_size(fs, path, "image_width");

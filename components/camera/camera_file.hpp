@@ -6,6 +6,7 @@
 #include <array>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace mocap::camera {
@@ -44,6 +45,8 @@ CameraIntrinsics from_fov(int width, int height, double hfov_deg);
 // or malformed) for a missing, empty, truncated or unparsable file, a missing key, a wrong matrix
 // shape or non-finite / non-positive values.
 CameraIntrinsics read_camera_file(const std::string& path);
+// The same from the text of a camera file; `name` stands for the file in messages.
+CameraIntrinsics parse_camera_file(std::string_view text, const std::string& name);
 
 // Writes a camera file (OpenCV YAML); an empty distortion is written as five zeros. `rms_px` >= 0
 // is written as avg_reprojection_error, a ground plane as ground_normal and ground_offset. Throws
@@ -62,6 +65,7 @@ double camera_tilt_deg(const GroundPlane& plane);
 // empty or unparsable file, one of the two keys without the other, a normal that is not a 3-vector,
 // not finite, zero or not of unit length (within 1e-3), or an offset that is not a finite number.
 std::optional<GroundPlane> read_ground_plane(const std::string& path);
+std::optional<GroundPlane> parse_ground_plane(std::string_view text, const std::string& name);
 
 // Rewrites the camera file `path` with its intrinsics (and avg_reprojection_error when present)
 // and the plane as ground_normal (3x1 matrix) and ground_offset (metres). Throws mocap::InputError

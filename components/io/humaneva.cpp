@@ -337,10 +337,14 @@ glm::dvec2 Camera::project(const glm::dvec3& world) const {
 
 std::map<std::string, std::array<Camera, kCameras>> load_cameras(
     const std::filesystem::path& file) {
-  const std::string source = file.string();
+  return parse_cameras(read_whole_file(file, 1u << 20), file.string());
+}
+
+std::map<std::string, std::array<Camera, kCameras>> parse_cameras(std::string_view text,
+                                                                  const std::string& source) {
   json doc;
   try {
-    doc = json::parse(read_whole_file(file, 1u << 20));
+    doc = json::parse(text);
   } catch (const json::exception& e) {
     throw InputError(source, std::string("not valid JSON: ") + e.what());
   }

@@ -107,6 +107,9 @@ struct Camera {
 
 // Subject ("S1".."S3") → the three cameras C1..C3. Throws InputError naming the JSON key.
 std::map<std::string, std::array<Camera, kCameras>> load_cameras(const std::filesystem::path& json);
+// The same from the file's text; `source` names it in messages.
+std::map<std::string, std::array<Camera, kCameras>> parse_cameras(std::string_view text,
+                                                                  const std::string& source);
 
 // HumanEva-15 → Body15 with the HumanEva-15 layout of core/keypoint_layout.hpp. Every Body15
 // joint is one HumanEva joint: root = pelvis (torsoDistal), neck = thorax, head = headDistal.

@@ -4,6 +4,7 @@
 #include <array>
 #include <cctype>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -253,14 +254,38 @@ void check_rest_convention(const Skeleton& s, const std::array<int, kRoles>& rol
 
 }  // namespace
 
-JointMap read_joint_map(const std::string& path) {
+namespace {
+
+// Map and rig files are small text files; anything beyond this is not one.
+constexpr std::uintmax_t kMaxRetargetFileBytes = 64u << 20;
+
+std::string read_text_file(const std::string& path, const char* what) {
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path, "cannot open the joint map file");
+  if (!in) throw InputError(path, std::string("cannot open the ") + what + " file");
+  std::error_code ec;
+  const std::uintmax_t size = std::filesystem::file_size(path, ec);
+  if (!ec && size > kMaxRetargetFileBytes)
+    throw InputError(path, std::string("too large for a ") + what + " file");
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) throw InputError(path, "read error");
+  return text.str();
+}
+
+}  // namespace
+
+JointMap read_joint_map(const std::string& path) {
+  return parse_joint_map(read_text_file(path, "joint map"), path);
+}
+
+JointMap parse_joint_map(std::string_view text, const std::string& path) {
   JointMap map;
   map.path = path;
-  std::string line;
   long number = 0;
-  while (std::getline(in, line)) {
+  while (!text.empty()) {
+    const std::size_t end = text.find('\n');
+    const std::string line(text.substr(0, end));
+    text = end == std::string_view::npos ? std::string_view() : text.substr(end + 1);
     ++number;
     if (line.size() > 4096) throw InputError(path, number, "line too long for a joint map");
     std::istringstream words(trim_comment(line));
@@ -279,18 +304,14 @@ JointMap read_joint_map(const std::string& path) {
     }
     map.entries.push_back({w[0], w[1], number});
   }
-  if (in.bad()) throw InputError(path, "read error");
   if (map.entries.empty()) throw InputError(path, "the joint map names no joints");
   return map;
 }
 
-Skeleton read_rig(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path, "cannot open the rig file");
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) throw InputError(path, "read error");
-  std::string bvh = text.str();
+Skeleton read_rig(const std::string& path) { return parse_rig(read_text_file(path, "rig"), path); }
+
+Skeleton parse_rig(std::string_view text, const std::string& path) {
+  std::string bvh(text);
   if (bvh.find_first_not_of(" \t\r\n") == std::string::npos)
     throw InputError(path, "the rig file is empty");
   // A rig may be a bare HIERARCHY: give it an empty MOTION section (after the text, so line

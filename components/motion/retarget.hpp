@@ -17,6 +17,7 @@
 
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "motion/skeleton.hpp"
@@ -38,10 +39,13 @@ struct JointMap {
 // Reads a map file: one "source_joint target_joint" pair per line; '#' starts a comment; blank
 // lines are skipped. Throws InputError naming the file and line.
 JointMap read_joint_map(const std::string& path);
+// The same from the map file's text; `path` names it in messages.
+JointMap parse_joint_map(std::string_view text, const std::string& path);
 
 // Reads a rig: a BVH file, with or without a MOTION section (its frames are not used).
 // Throws InputError naming the file.
 Skeleton read_rig(const std::string& path);
+Skeleton parse_rig(std::string_view text, const std::string& path);
 
 struct RetargetOptions {
   std::optional<float> scale;  // target units per source unit; nullopt: ratio of hip heights

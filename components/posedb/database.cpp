@@ -25,9 +25,15 @@ bool parse_body_choice(std::string_view text, BodyChoice& out) {
 }
 namespace {
 
-// Owns one read-only mapping of a whole file.
+// The bytes of a whole file: a read-only mapping of it, or a copy in memory.
 class MappedFile {
  public:
+  struct InMemory {};
+  MappedFile(InMemory, std::string bytes) : copy_(std::move(bytes)) {
+    // std::string's buffer comes from operator new: aligned for every record type.
+    data_ = copy_.empty() ? nullptr : reinterpret_cast<const std::byte*>(copy_.data());
+    size_ = copy_.size();
+  }
   explicit MappedFile(const std::string& path) {
     const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
     if (fd < 0) throw InputError(path, std::string("cannot open: ") + std::strerror(errno));
@@ -51,12 +57,13 @@ class MappedFile {
   MappedFile(const MappedFile&) = delete;
   MappedFile& operator=(const MappedFile&) = delete;
   ~MappedFile() {
-    if (data_) ::munmap(const_cast<std::byte*>(data_), size_);
+    if (data_ && copy_.empty()) ::munmap(const_cast<std::byte*>(data_), size_);
   }
   const std::byte* data() const { return data_; }
   std::uint64_t size() const { return size_; }
 
  private:
+  std::string copy_;
   const std::byte* data_ = nullptr;
   std::uint64_t size_ = 0;
 };
@@ -82,6 +89,8 @@ struct Database::Impl {
   Section frames, joints, rotations, projections, records, centroids, clusters;
 
   explicit Impl(const std::string& p) : path(p), file(p) {}
+  Impl(std::string bytes, const std::string& name)
+      : path(name), file(MappedFile::InMemory{}, std::move(bytes)) {}
   [[noreturn]] void fail(const std::string& what) const { throw InputError(path, what); }
 
   void load(bool verify);
@@ -198,6 +207,12 @@ void Database::Impl::check_consistency() const {
 
 Database Database::open(const std::string& path, bool verify_checksums) {
   auto impl = std::make_unique<Impl>(path);
+  impl->load(verify_checksums);
+  return Database(std::move(impl));
+}
+
+Database Database::from_bytes(std::string bytes, const std::string& name, bool verify_checksums) {
+  auto impl = std::make_unique<Impl>(std::move(bytes), name);
   impl->load(verify_checksums);
   return Database(std::move(impl));
 }

@@ -73,6 +73,10 @@ class Database {
   // Maps and validates the file; throws InputError naming the file and the problem for a
   // missing, truncated, corrupted (checksum), foreign or newer-version file.
   static Database open(const std::string& path, bool verify_checksums = true);
+  // The same checks on the bytes of a database file held in memory (copied in); `name` stands
+  // for the file in messages.
+  static Database from_bytes(std::string bytes, const std::string& name,
+                             bool verify_checksums = true);
 
   Database(Database&&) noexcept;
   Database& operator=(Database&&) noexcept;

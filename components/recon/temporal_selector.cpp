@@ -92,9 +92,11 @@ std::vector<std::size_t> best_path(std::span<const std::vector<Candidate>> candi
   for (const auto& [frame, choice] : decisions) {
     if (!choice) continue;
     const auto& c = candidates[frame];
+    // A named copy: clang before 16 cannot capture a structured binding.
+    const auto projection = choice->projection;
     path[frame] = static_cast<std::size_t>(
         std::find_if(c.begin(), c.end(),
-                     [&](const Candidate& x) { return x.projection == choice->projection; }) -
+                     [&](const Candidate& x) { return x.projection == projection; }) -
         c.begin());
   }
   return path;
