@@ -30,6 +30,19 @@ int read_size(const cv::FileStorage& fs, const std::string& path, const std::str
 
 cv::Mat read_matrix(const cv::FileStorage& fs, const std::string& path, const std::string& key) {
   const cv::FileNode node = required(fs, path, key);
+  // OpenCV allocates rows x cols before it reads the data: the shape is checked first against
+  // the data and a size no camera file needs, so "rows: 2000000000" cannot allocate gigabytes.
+  if (!node.isMap()) throw InputError(path, "key '" + key + "' is not an OpenCV matrix");
+  const cv::FileNode rows = node["rows"], cols = node["cols"], values = node["data"];
+  if (!rows.isInt() || !cols.isInt() || !values.isSeq())
+    throw InputError(path, "key '" + key + "' is not an OpenCV matrix (rows, cols, data)");
+  constexpr int kMaxSide = 64;
+  const int r = static_cast<int>(rows), c = static_cast<int>(cols);
+  if (r < 1 || c < 1 || r > kMaxSide || c > kMaxSide ||
+      values.size() != static_cast<std::size_t>(r) * static_cast<std::size_t>(c))
+    throw InputError(path, "key '" + key + "' has a shape (" + std::to_string(r) + "x" +
+                               std::to_string(c) + ") that does not fit its " +
+                               std::to_string(values.size()) + " values");
   cv::Mat m;
   try {
     node >> m;
