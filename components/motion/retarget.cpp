@@ -324,10 +324,31 @@ Skeleton parse_rig(std::string_view text, const std::string& path) {
   return std::move(clip.skeleton);
 }
 
+namespace {
+
+// Squared bone lengths are formed in float: offsets beyond this (file units: a kilometre in
+// centimetres) would overflow them into inf and NaN rotations. No real rig comes near it.
+constexpr float kMaxOffset = 1e5f;
+
+void check_offsets(const Skeleton& skeleton, const std::string& name) {
+  for (const SkeletonJoint& j : skeleton.joints) {
+    for (int i = 0; i < 3; ++i) {
+      if (!(std::abs(j.offset[i]) <= kMaxOffset))
+        throw InputError(name, "joint '" + j.name + "' has an OFFSET beyond " +
+                                   std::to_string(static_cast<long>(kMaxOffset)) +
+                                   " units: not a rig");
+    }
+  }
+}
+
+}  // namespace
+
 RetargetResult retarget(const Clip& source, const Skeleton& target,
                         const RetargetOptions& options) {
   const Skeleton& src = source.skeleton;
   const std::string& target_name = options.target_source;
+  check_offsets(src, source.source);
+  check_offsets(target, target_name);
   RetargetResult result;
   std::vector<int> source_of(target.joints.size(), -1);
   std::vector<std::string> how(target.joints.size());
