@@ -85,6 +85,9 @@ void open_text(cv::FileStorage& fs, std::string_view text, const std::string& na
   try {
     if (!fs.open(std::string(text), cv::FileStorage::READ | cv::FileStorage::MEMORY))
       throw InputError(name, "not an OpenCV YAML/XML/JSON file");
+    // Keys are looked up in the root node: OpenCV throws for any other kind there.
+    if (!fs.root().isMap())
+      throw InputError(name, "not a camera file (its top level is not a map of keys)");
   } catch (const cv::Exception& e) {
     throw InputError(name, "not a readable OpenCV YAML file (" + e.err + ")");
   }
