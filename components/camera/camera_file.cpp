@@ -90,6 +90,12 @@ void open_text(cv::FileStorage& fs, std::string_view text, const std::string& na
       throw InputError(name, "not a camera file (its top level is not a map of keys)");
   } catch (const cv::Exception& e) {
     throw InputError(name, "not a readable OpenCV YAML file (" + e.err + ")");
+  } catch (const InputError&) {
+    throw;
+  } catch (const std::exception& e) {
+    // OpenCV 4.6's YAML parser lets standard exceptions out on some malformed text (e.g.
+    // std::length_error from a key it mis-measures).
+    throw InputError(name, std::string("not a readable OpenCV YAML file (") + e.what() + ")");
   }
 }
 
