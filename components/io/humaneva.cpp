@@ -263,8 +263,11 @@ std::vector<const Chunk*> Dataset::select(std::optional<Split> split, std::strin
 }
 
 Dataset read_positions_3d(const std::filesystem::path& npz, const NpyLimits& limits) {
-  const std::string source = npz.string();
-  const NpyContent content = NpzFile::open(npz, limits).read("positions_3d");
+  return read_positions_3d(NpzFile::open(npz, limits), npz.string());
+}
+
+Dataset read_positions_3d(const NpzFile& file, const std::string& source) {
+  const NpyContent content = file.read("positions_3d");
   const Pickle::Value subjects = dict_root(content, source);
   Dataset out;
   for (std::size_t s = 0; s < subjects.dict_size(); ++s) {
@@ -288,8 +291,10 @@ Dataset read_positions_3d(const std::filesystem::path& npz, const NpyLimits& lim
 
 void attach_positions_2d(Dataset& dataset, const std::filesystem::path& npz,
                          const NpyLimits& limits) {
-  const std::string source = npz.string();
-  const NpzFile file = NpzFile::open(npz, limits);
+  attach_positions_2d(dataset, NpzFile::open(npz, limits), npz.string());
+}
+
+void attach_positions_2d(Dataset& dataset, const NpzFile& file, const std::string& source) {
   check_metadata(file, source);
   const NpyContent content = file.read("positions_2d");
   const Pickle::Value subjects = dict_root(content, source);

@@ -90,6 +90,9 @@ Dataset load_dataset(const std::filesystem::path& folder, const LoadOptions& opt
 Dataset read_positions_3d(const std::filesystem::path& npz, const NpyLimits& limits = {});
 void attach_positions_2d(Dataset& dataset, const std::filesystem::path& npz,
                          const NpyLimits& limits = {});
+// The same from an archive already open (e.g. NpzFile::from_bytes); `source` names it in messages.
+Dataset read_positions_3d(const NpzFile& file, const std::string& source);
+void attach_positions_2d(Dataset& dataset, const NpzFile& file, const std::string& source);
 
 struct Camera {
   std::string id;  // "C1"

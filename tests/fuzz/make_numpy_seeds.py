@@ -45,7 +45,7 @@ with zipfile.ZipFile(b,'w',zipfile.ZIP_STORED,allowZip64=True) as zf:
     with zf.open('big.npy','w',force_zip64=True) as f: f.write(npy(np.arange(4,dtype='<f4')))
 w('npz','zip64.npz',b.getvalue())
 b=io.BytesIO()
-with zipfile.ZipFile(b,'w') as zf: zf.writestr('x.npy','hello')
+with zipfile.ZipFile(b,'w') as zf: zf.writestr(zipfile.ZipInfo('x.npy', (1980, 1, 1, 0, 0, 0)),'hello')
 w('npz','not_npy_member.npz',b.getvalue())
 for proto in (2,3,4,5):
     w('pickle','dict_p%d.pkl'%proto,pickle.dumps({'a':[1,2.5,None,True,'s',b'b',(1,)],'b':{}} ,protocol=proto))
@@ -62,3 +62,26 @@ w('pickle','evil_global.pkl',b'\x80\x02cos\nsystem\nq\x00X\x02\x00\x00\x00lsq\x0
 w('pickle','big_int.pkl',pickle.dumps(2**200,protocol=2))
 w('pickle','long_string_len.pkl',b'\x80\x04\x8d\xff\xff\xff\xff\xff\xff\xff\x7fabc.')
 w('pickle','empty.pkl',b'')
+# HumanEva-I as VideoPose3D stores it (humaneva_npz): positions_3d, positions_2d and metadata in
+# one archive, a few frames per chunk.
+import os
+os.makedirs('humaneva_npz', exist_ok=True)
+def he(chunks, compressed=True, meta=True, two_d=True):
+    p3 = {}
+    p2 = {}
+    for subject, action, frames in chunks:
+        p3.setdefault(subject, {})[action] = np.arange(frames * 45, dtype='f4').reshape(frames, 15, 3) / 100
+        p2.setdefault(subject, {})[action] = [np.ones((frames, 15, 2), 'f4') * k for k in range(3)]
+    arrays = {}
+    o3 = np.empty((), dtype=object); o3[()] = p3; arrays['positions_3d'] = o3
+    if two_d:
+        o2 = np.empty((), dtype=object); o2[()] = p2; arrays['positions_2d'] = o2
+    if meta:
+        m = np.empty((), dtype=object); m[()] = {'num_joints': 15, 'keypoints_symmetry': [[2, 3], [5, 6]]}; arrays['metadata'] = m
+    b = io.BytesIO(); (np.savez_compressed if compressed else np.savez)(b, **arrays); return b.getvalue()
+w('humaneva_npz', 'train_s1_walking.npz', he([('Train/S1', 'Walking 1 chunk0', 4)]))
+w('humaneva_npz', 'two_subjects_stored.npz', he([('Train/S1', 'Jog 1 chunk0', 3), ('Validate/S2', 'Box 1 chunk1', 2)], compressed=False))
+w('humaneva_npz', 'only_3d.npz', he([('Train/S3', 'Gestures 1 chunk0', 2)], meta=False, two_d=False))
+w('humaneva_npz', 'unknown_action.npz', he([('Train/S1', 'Dancing 1 chunk0', 2)]))
+w('humaneva_npz', 'bad_subject.npz', he([('Test/S9', 'Walking 1 chunk0', 2)]))
+w('humaneva_npz', 'huge_chunk_number.npz', he([('Train/S1', 'Walking 1 chunk99999999999', 2)]))
