@@ -1,6 +1,7 @@
 #include "graph/wire_format.hpp"
 
 #include <bit>
+#include <cmath>
 #include <cstring>
 #include <nlohmann/json.hpp>
 
@@ -342,6 +343,21 @@ Packet decode_pose_matches(const Header& header, std::span<const Frame> payload)
   return Packet::of<PoseMatches>(std::move(m));
 }
 
+// A number of a GraphStats node entry: counts must be non-negative integers, times any finite
+// number (a JSON 1e61 converted to an integer would be undefined behaviour).
+std::uint64_t stats_count(const nlohmann::json& node, const char* key) {
+  const nlohmann::json& v = node.at(key);
+  if (v.is_number_unsigned()) return v.get<std::uint64_t>();
+  throw WireError(std::string("GraphStats: '") + key + "' is not a non-negative integer");
+}
+
+double stats_time(const nlohmann::json& node, const char* key) {
+  const nlohmann::json& v = node.at(key);
+  if (!v.is_number() || !std::isfinite(v.get<double>()))
+    throw WireError(std::string("GraphStats: '") + key + "' is not a finite number");
+  return v.get<double>();
+}
+
 Packet decode_stats(const Header& header, std::span<const Frame> payload) {
   if (payload[0].size > kMaxStatsBytes) throw WireError("GraphStats: too large");
   auto m = with_header<GraphStats>(header);
@@ -352,10 +368,12 @@ Packet decode_stats(const Header& header, std::span<const Frame> payload) {
     m->graph = json.at("graph").get<std::string>();
     for (const auto& n : json.at("nodes")) {
       // "status" came later within version 1: a sender without it has no status to report.
-      m->nodes.push_back(NodeStats{n.at("node"), n.at("type"), n.at("process"), n.at("in"),
-                                   n.at("out"), n.at("drops"), n.at("p50_us"), n.at("p95_us"),
-                                   n.at("queue_depth"), n.at("max_queue_depth"), n.at("state"),
-                                   n.value("status", std::string())});
+      m->nodes.push_back(NodeStats{
+          n.at("node"), n.at("type"), n.at("process"), stats_count(n, "in"), stats_count(n, "out"),
+          stats_count(n, "drops"), stats_time(n, "p50_us"), stats_time(n, "p95_us"),
+          static_cast<std::size_t>(stats_count(n, "queue_depth")),
+          static_cast<std::size_t>(stats_count(n, "max_queue_depth")), n.at("state"),
+          n.value("status", std::string())});
     }
   } catch (const nlohmann::json::exception& e) {
     throw WireError(std::string("GraphStats: ") + e.what());
