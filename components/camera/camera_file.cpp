@@ -82,6 +82,16 @@ void open_text(cv::FileStorage& fs, std::string_view text, const std::string& na
   // OpenCV reads C strings: text with a NUL byte would be cut there, so it is refused whole.
   if (text.find('\0') != std::string_view::npos)
     throw InputError(name, "not a text file (NUL byte)");
+  // A camera file is one YAML document. OpenCV 4.6's YAML parser loops forever on some texts
+  // with a second document start (e.g. "---YAML:1.0" then "---" and a list), and looks keys up
+  // in another document than root(): more than one "---" line is refused before it parses.
+  int document_starts = 0;
+  for (std::size_t at = 0; at < text.size();) {
+    if (text.compare(at, 3, "---") == 0 && ++document_starts > 1)
+      throw InputError(name, "more than one YAML document (a second '---' line)");
+    const std::size_t end = text.find('\n', at);
+    at = end == std::string_view::npos ? text.size() : end + 1;
+  }
   try {
     if (!fs.open(std::string(text), cv::FileStorage::READ | cv::FileStorage::MEMORY))
       throw InputError(name, "not an OpenCV YAML/XML/JSON file");
@@ -130,8 +140,12 @@ std::optional<GroundPlane> parse_ground_plane(std::string_view text, const std::
   cv::FileStorage fs;
   open_text(fs, text, path);
   const auto present = [&](const char* key) {
-    const cv::FileNode node = fs[key];
-    return !node.empty() && !node.isNone();
+    try {
+      const cv::FileNode node = fs[key];
+      return !node.empty() && !node.isNone();
+    } catch (const cv::Exception& e) {
+      throw InputError(path, "malformed camera file (" + e.err + ")");
+    }
   };
   const bool has_normal = present("ground_normal");
   const bool has_offset = present("ground_offset");
