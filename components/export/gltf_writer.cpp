@@ -97,6 +97,8 @@ void validate(const GltfFigure& figure) {
     throw std::invalid_argument("make_glb: " + clip.source + " has no frames");
   if (!(clip.frame_time > 0.0) || !std::isfinite(clip.frame_time))
     throw std::invalid_argument("make_glb: " + clip.source + " has no positive frame time");
+  if (!(figure.start_seconds >= 0.0) || !std::isfinite(figure.start_seconds))
+    throw std::invalid_argument("make_glb: figure '" + figure.name + "' starts before 0 s");
   if (clip.values.size() < static_cast<std::size_t>(clip.frame_count) *
                                static_cast<std::size_t>(clip.skeleton.channel_count))
     throw std::invalid_argument("make_glb: " + clip.source + " has fewer values than frames");
@@ -241,7 +243,8 @@ std::vector<int> add_figure(const GltfFigure& figure, bool prefix, const GltfOpt
   // Animation: one key per frame.
   const motion::PoseSequence poses = motion::to_poses(clip);
   std::vector<float> times(static_cast<std::size_t>(clip.frame_count));
-  for (int f = 0; f < clip.frame_count; ++f) times[f] = static_cast<float>(f * clip.frame_time);
+  for (int f = 0; f < clip.frame_count; ++f)
+    times[f] = static_cast<float>(figure.start_seconds + f * clip.frame_time);
   const int time_accessor =
       buffers.accessor(buffers.view(times.data(), times.size() * sizeof(float), 0), kFloat,
                        TINYGLTF_TYPE_SCALAR, times.size(), {times.front()}, {times.back()});

@@ -28,6 +28,7 @@ struct GltfFigure {
   std::string name;  // names the figure's nodes, skin and mesh (e.g. "person_3")
   const motion::Clip* clip = nullptr;
   float metres_per_unit = 0.0f;  // 0: metres_per_unit_of(clip->skeleton)
+  double start_seconds = 0.0;    // time of the first key (figures starting later in a shared file)
 };
 
 struct GltfOptions {

@@ -19,13 +19,15 @@ std::string PeopleBvhSummary::describe() const {
 
 PeopleBvhWriter::PeopleBvhWriter(const posedb::Database& db, PeopleBvhOptions options)
     : db_(db), options_(std::move(options)) {
-  if (options_.dir.empty()) throw InputError("dir", "no output folder given");
+  if (options_.dir.empty() && !options_.in_memory)
+    throw InputError("dir", "no output folder given");
   if (!(options_.fps > 0.0) || !std::isfinite(options_.fps))
     throw std::invalid_argument("PeopleBvhWriter: fps must be positive");
   if (options_.max_open_files < 1)
     throw std::invalid_argument("PeopleBvhWriter: max_open_files must be at least 1");
   if (options_.min_frames < 1)
     throw std::invalid_argument("PeopleBvhWriter: min_frames must be at least 1");
+  if (options_.in_memory) return;
   std::error_code ec;
   std::filesystem::create_directories(options_.dir, ec);
   if (ec) throw InputError(options_.dir, "cannot create the output folder: " + ec.message());
@@ -68,8 +70,9 @@ void PeopleBvhWriter::start(const Person3D& person, std::int64_t frame,
   maker.channels(db_, *pose, seconds(frame), values, placement);
   Track& track =
       tracks_
-          .emplace(person.id,
-                   Track{std::nullopt, skeleton, std::move(maker), std::move(values), {}, frame})
+          .emplace(
+              person.id,
+              Track{std::nullopt, skeleton, std::move(maker), std::move(values), {}, frame, frame})
           .first->second;
   emit(person.id, track);
 }
@@ -83,7 +86,7 @@ void PeopleBvhWriter::emit(int id, Track& track) {
     return;
   }
   track.pending.push_back(track.values);
-  if (static_cast<int>(track.pending.size()) < options_.min_frames) return;
+  if (options_.in_memory || static_cast<int>(track.pending.size()) < options_.min_frames) return;
   keep_open_files_bounded(id);
   track.file.emplace(path_for(id), track.skeleton, 1.0 / options_.fps);
   ++summary_.files;
@@ -127,9 +130,42 @@ void PeopleBvhWriter::keep_open_files_bounded(int arriving_id) {
   if (open >= options_.max_open_files && oldest) oldest->file->suspend();
 }
 
+std::vector<PersonClip> PeopleBvhWriter::take_clips() {
+  std::vector<PersonClip> out;
+  for (auto& [id, track] : tracks_) {
+    if (track.pending.empty()) continue;
+    PersonClip& person = out.emplace_back();
+    person.id = id;
+    person.first_frame = track.first_frame;
+    motion::Clip& clip = person.clip;
+    clip.source = "person " + std::to_string(id);
+    clip.skeleton = track.skeleton;
+    clip.skeleton.assign_channel_slots();
+    clip.frame_time = 1.0 / options_.fps;
+    clip.frame_count = static_cast<int>(track.pending.size());
+    for (const std::vector<float>& values : track.pending)
+      clip.values.insert(clip.values.end(), values.begin(), values.end());
+    track.pending = {};
+  }
+  return out;
+}
+
 void PeopleBvhWriter::close() {
   std::exception_ptr first_error;
   for (auto& [id, track] : tracks_) {
+    if (options_.in_memory) {
+      const auto frames = static_cast<std::int64_t>(track.pending.size());
+      if (frames == 0) continue;
+      if (frames < options_.min_frames) {
+        ++summary_.short_tracks;
+        track.pending = {};
+      } else if (!track.counted) {
+        track.counted = true;
+        ++summary_.files;
+        summary_.frames += frames;
+      }
+      continue;
+    }
     if (!track.file) {
       if (!track.pending.empty()) ++summary_.short_tracks;
       track.pending = {};

@@ -11,6 +11,9 @@
 // A tracker also makes short-lived ids (a false detection, a person seen for a moment): a file is
 // only started once its person has `min_frames` frames, which are held in memory until then; an
 // id that never gets there leaves no file and is counted as a short track.
+//
+// With `in_memory` the same frames are kept as one motion::Clip per person instead of files
+// (take_clips() after close()): for writers of whole files at the end of a stream (sink.gltf).
 
 #include <cstdint>
 #include <map>
@@ -35,10 +38,18 @@ struct PeopleBvhOptions {
   // 1-Euro filter (on the rotation group, per joint) smooths them, as the paper smooths its motion.
   bool smooth_rotations = true;
   OneEuroParams smoothing;  // the paper's beta 0.4, fc_min 1 Hz
+  bool in_memory = false;   // no files (dir unused): every person's frames stay in memory
+};
+
+// A person's motion kept in memory: `first_frame` is the input frame of clip frame 0.
+struct PersonClip {
+  int id = -1;
+  std::int64_t first_frame = 0;
+  motion::Clip clip;
 };
 
 struct PeopleBvhSummary {
-  std::int64_t files = 0;
+  std::int64_t files = 0;              // in memory: people kept
   std::int64_t frames = 0;             // frame lines written, held ones included
   std::int64_t held_over_gaps = 0;     // repeated poses for input frames a person was missing in
   std::int64_t skeleton_mismatch = 0;  // pose from a clip of another skeleton: previous one held
@@ -60,6 +71,10 @@ class PeopleBvhWriter {
   // Closes every file (all of them, even when one fails); throws the first error. Idempotent.
   void close();
 
+  // In memory: every person with at least min_frames frames, by id, after close(); the
+  // writer's frames are moved out.
+  std::vector<PersonClip> take_clips();
+
   std::string path_for(int id) const;
   const PeopleBvhSummary& summary() const { return summary_; }
 
@@ -71,6 +86,8 @@ class PeopleBvhWriter {
     std::vector<float> values;                // the last pose written
     std::vector<std::vector<float>> pending;  // frames before the file exists
     std::int64_t last_frame = 0;
+    std::int64_t first_frame = 0;
+    bool counted = false;  // in memory: in the summary already (close() is idempotent)
   };
 
   double seconds(std::int64_t frame) const;
