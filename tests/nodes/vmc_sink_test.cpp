@@ -275,6 +275,30 @@ TEST(VmcSink, AllPeopleGoToSuccessivePorts) {
   EXPECT_EQ(second->bundle_count(), static_cast<std::size_t>(frames - 5));  // person 5 from frame 5
 }
 
+// One port: person 3 in frames 0-9, nobody in 10-39, person 5 in 40-49. Person 3 has been gone
+// 1.24 s when person 5 comes (40 ms per frame): with release_s 1 person 5 gets the port, with 10
+// it is not sent.
+TEST(VmcSink, APortIsGivenToTheNextPersonAfterReleaseTime) {
+  MOCAP_REQUIRE_SMALL_DATABASE(db);
+  std::string s;
+  for (int f = 0; f < 50; ++f) {
+    if (f) s += ';';
+    if (f < 10) s += "3:0:" + std::to_string(f) + ":4";
+    if (f >= 40) s += "5:1:" + std::to_string(f) + ":2";
+  }
+  for (const auto& [release, expected] : {std::pair{"1", 20u}, std::pair{"10", 10u}}) {
+    OscReceiver receiver;
+    ASSERT_TRUE(receiver.ok());
+    const graph::RunResult result =
+        run_graph(vmc_graph(db, s,
+                            "port: " + std::to_string(receiver.port()) +
+                                ", all_people: true, max_people: 1, release_s: " + release));
+    ASSERT_TRUE(result.ok) << result.error;
+    receiver.wait_for(expected);
+    EXPECT_EQ(receiver.bundle_count(), expected) << "release_s " << release;
+  }
+}
+
 TEST(VmcSink, UnknownPersonChoiceIsRefusedNamingTheNode) {
   MOCAP_REQUIRE_SMALL_DATABASE(db);
   const graph::RunResult result = run_graph(vmc_graph(db, "1:0:0:0", "person: tallest"));

@@ -53,9 +53,14 @@ class VmcSink : public Node {
                          "who is sent: first (the earliest id still in view), largest (the "
                          "biggest in the image), or a person id");
     c.param<bool>("all_people", false,
-                  "send everybody, the k-th person (in order of appearance) to port + k");
+                  "send everybody, each person to their own port from port on (kept while they "
+                  "are seen, given to a new person after release_s)");
     c.param<int>("max_people", 8, "with all_people: ports port .. port + max_people - 1",
                  {1, 1000});
+    c.param<double>("release_s", 1.0,
+                    "with all_people: a port whose person has not been seen for this long is "
+                    "given to the next new person",
+                    {0.0, 1e6});
     c.param<double>("fps", 30.0, "frame rate for /VMC/Ext/T when messages carry no capture time",
                     {0.001, 10000.0});
   }
@@ -66,6 +71,7 @@ class VmcSink : public Node {
     all_ = ctx.param<bool>("all_people");
     max_people_ = ctx.param<int>("max_people");
     fps_ = ctx.param<double>("fps");
+    release_s_ = ctx.param<double>("release_s");
     person_ = ctx.param<std::string>("person");
     if (person_ != "first" && person_ != "largest") {
       try {
@@ -88,7 +94,7 @@ class VmcSink : public Node {
     if (all_) {
       for (const Person3D& person : people.people) {
         if (person.id < 0) continue;
-        exporting::VmcSender* sender = sender_for(person.id);
+        exporting::VmcSender* sender = sender_for(person.id, t);
         if (sender) send(*sender, people, person, t);
       }
       return;
@@ -147,16 +153,28 @@ class VmcSink : public Node {
     return best;
   }
 
-  exporting::VmcSender* sender_for(int id) {
+  // The port of a person: theirs while they are seen; a new person takes a port never used or
+  // one whose person has been away for release_s; none when every port is busy.
+  exporting::VmcSender* sender_for(int id, double t) {
     const auto slot = slots_.find(id);
-    if (slot != slots_.end()) return senders_[slot->second].get();
-    const int next = static_cast<int>(slots_.size());
-    if (next >= max_people_) return nullptr;  // more people than ports: not sent
-    slots_.emplace(id, next);
-    while (static_cast<int>(senders_.size()) <= next)
+    if (slot != slots_.end()) {
+      slot->second.last_seen = t;
+      return senders_[slot->second.port].get();
+    }
+    int port = static_cast<int>(slots_.size());
+    if (port >= max_people_) {
+      auto oldest = slots_.end();
+      for (auto it = slots_.begin(); it != slots_.end(); ++it)
+        if (oldest == slots_.end() || it->second.last_seen < oldest->second.last_seen) oldest = it;
+      if (oldest == slots_.end() || t - oldest->second.last_seen < release_s_) return nullptr;
+      port = oldest->second.port;
+      slots_.erase(oldest);
+    }
+    slots_.emplace(id, Slot{port, t});
+    while (static_cast<int>(senders_.size()) <= port)
       senders_.push_back(
           std::make_unique<exporting::VmcSender>(host_, port_ + static_cast<int>(senders_.size())));
-    return senders_[next].get();
+    return senders_[port].get();
   }
 
   void send(exporting::VmcSender& sender, const People3D& people, const Person3D& person,
@@ -173,7 +191,12 @@ class VmcSink : public Node {
   std::optional<int> fixed_id_;
   int current_ = -1;
   std::map<int, std::int64_t> first_seen_;  // id -> first frame
-  std::map<int, int> slots_;                // id -> port offset (all_people)
+  struct Slot {
+    int port = 0;  // offset from port_
+    double last_seen = 0.0;
+  };
+  std::map<int, Slot> slots_;  // id -> its port (all_people)
+  double release_s_ = 1.0;
   std::vector<std::unique_ptr<exporting::VmcSender>> senders_;
   bool started_ = false;
   std::int64_t first_ns_ = 0, first_frame_ = 0;
