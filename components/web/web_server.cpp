@@ -259,6 +259,8 @@ struct WebServer::Impl {
   tcp::acceptor acceptor{io};
   std::thread thread;
   std::string host;
+  int port = 0;
+  bool v6 = false;
 
   void accept_next() {
     acceptor.async_accept([this](beast::error_code ec, tcp::socket socket) {
@@ -282,6 +284,9 @@ WebServer::WebServer(ServerOptions options) : impl_(std::make_unique<Impl>()) {
     s.acceptor.set_option(asio::socket_base::reuse_address(true));
     s.acceptor.bind(endpoint);
     s.acceptor.listen(asio::socket_base::max_listen_connections);
+    // Kept here: the acceptor belongs to the server thread once it runs.
+    s.port = s.acceptor.local_endpoint().port();
+    s.v6 = s.acceptor.local_endpoint().address().is_v6();
   } catch (const boost::system::system_error& e) {
     throw std::runtime_error("web server: cannot listen on " + where + ": " + e.code().message());
   }
@@ -301,12 +306,11 @@ WebServer::~WebServer() {
   s.thread.join();
 }
 
-int WebServer::port() const { return impl_->acceptor.local_endpoint().port(); }
+int WebServer::port() const { return impl_->port; }
 
 std::string WebServer::url() const {
-  const bool v6 = impl_->acceptor.local_endpoint().address().is_v6();
-  return "http://" + (v6 ? "[" + impl_->host + "]" : impl_->host) + ":" + std::to_string(port()) +
-         "/";
+  return "http://" + (impl_->v6 ? "[" + impl_->host + "]" : impl_->host) + ":" +
+         std::to_string(port()) + "/";
 }
 
 void WebServer::broadcast(std::string text) {

@@ -46,7 +46,7 @@ inline People3D walking_people(int count, std::int64_t frame, double fps = 30.0)
   for (int i = 0; i < count; ++i) {
     const float x = (static_cast<float>(i) - 0.5f * static_cast<float>(count - 1)) * 0.8f;
     out.people.push_back(walking_person(
-        i + 1, static_cast<float>(frame) * 0.2f + static_cast<float>(i), {x, 0.55f, 3.0f}));
+        i + 1, static_cast<float>(frame) * 0.2f + static_cast<float>(i), {x, 0.3f, 3.0f}));
   }
   return out;
 }

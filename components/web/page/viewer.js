@@ -25,7 +25,10 @@ const headIndex = () => Math.max(0, skeleton.joints.indexOf("head"));
 
 // ---- the 3D scene -------------------------------------------------------------------------
 const canvas3d = $("canvas3d");
-const renderer = new THREE.WebGLRenderer({ canvas: canvas3d, antialias: true, preserveDrawingBuffer: true });
+// ?aa=0 turns antialiasing off (software rendering, e.g. a headless browser, is faster without).
+const antialias = new URLSearchParams(location.search).get("aa") !== "0";
+// preserveDrawingBuffer: the canvas can be read back (tests count its pixels).
+const renderer = new THREE.WebGLRenderer({ canvas: canvas3d, antialias, preserveDrawingBuffer: true });
 renderer.setPixelRatio(window.devicePixelRatio || 1);
 renderer.setClearColor(BACKGROUND);
 const scene = new THREE.Scene();
