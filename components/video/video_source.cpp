@@ -75,6 +75,10 @@ ImageBuffer wrap(std::shared_ptr<cv::Mat> mat) {
 // Frames a container announces that a complete file may still fall short of (rounding in the
 // header's duration, a last frame the decoder holds back).
 constexpr std::int64_t kFrameCountSlack = 2;
+// Beyond the slack, up to this fraction of the announced frames may be missing at the end: damaged
+// frames in the middle that FFmpeg could not decode and passed over (it says nothing else about
+// them). More is taken for a file cut short.
+constexpr double kUndecodableFraction = 0.1;
 
 }  // namespace
 
@@ -130,7 +134,8 @@ struct VideoSource::Impl {
   std::int64_t frame_count = -1;
   std::int64_t next_index = 0;  // index of the next frame read() returns
   double last_media_time = -1.0;
-  std::optional<Frame> first;  // decoded while opening, returned by the first read()
+  std::int64_t undecodable = 0;  // announced frames not decoded, known at the end
+  std::optional<Frame> first;    // decoded while opening, returned by the first read()
 
   [[noreturn]] void fail(const std::string& what) const { throw InputError(source, what); }
 
@@ -305,14 +310,18 @@ struct VideoSource::Impl {
   }
 
   // A capture that stops: the normal end of a file or stream, or an error.
-  void end_of_input() const {
+  void end_of_input() {
     if (kind == SourceKind::device)
       fail("the camera device stopped delivering frames after " + std::to_string(next_index) +
            " (unplugged?)");
     if (kind == SourceKind::file && frame_count > 0 &&
         next_index + kFrameCountSlack < frame_count) {
-      fail("truncated or damaged: decoding stopped after " + std::to_string(next_index) +
-           " of the " + std::to_string(frame_count) + " frames its container announces");
+      const std::int64_t missing = frame_count - next_index;
+      if (static_cast<double>(missing) > kUndecodableFraction * static_cast<double>(frame_count)) {
+        fail("truncated or damaged: decoding stopped after " + std::to_string(next_index) +
+             " of the " + std::to_string(frame_count) + " frames its container announces");
+      }
+      undecodable = missing;
     }
   }
 };
@@ -354,6 +363,7 @@ int VideoSource::width() const { return impl_->width; }
 int VideoSource::height() const { return impl_->height; }
 double VideoSource::fps() const { return impl_->fps; }
 std::int64_t VideoSource::frame_count() const { return impl_->frame_count; }
+std::int64_t VideoSource::frames_undecodable() const { return impl_->undecodable; }
 std::int64_t VideoSource::frames_read() const { return impl_->next_index - (impl_->first ? 1 : 0); }
 
 }  // namespace mocap::video

@@ -135,6 +135,52 @@ TEST(VideoSourceNode, ATruncatedVideoStopsTheGraphNamingTheNodeAndTheFile) {
   EXPECT_GT(seen.size(), 10u);  // the frames before the cut went through
 }
 
+// A copy of the clip with 20000 random bytes at a quarter, half and three quarters of it: FFmpeg
+// passes over the frames it
+// cannot decode; the run goes on to the end and counts them (drops, status line).
+TEST(VideoSourceNode, CorruptFramesInTheMiddleAreSkippedAndCounted) {
+  if (!fs::exists(kVtestPart)) GTEST_SKIP() << "shared video absent: " << kVtestPart;
+  const test::TempDir dir;
+  const std::string copy = dir.file("corrupt.avi");
+  std::string bytes = test::read_file(kVtestPart);
+  std::uint32_t state = 12345;
+  for (const std::size_t start : {bytes.size() / 4, bytes.size() / 2, 3 * bytes.size() / 4}) {
+    for (std::size_t i = start; i < start + 20000; ++i) {
+      state = state * 1664525u + 1013904223u;
+      bytes[i] = static_cast<char>(state >> 24);
+    }
+  }
+  test::write_file(copy, bytes);
+  seen.clear();
+  const RunResult result = testing::run_graph(graph_yaml("path: " + copy + ", mode: offline"));
+  ASSERT_TRUE(result.ok) << result.error;
+  const NodeStats& src = testing::stats_of(result, "src");
+  EXPECT_GT(src.drops, 0u);
+  EXPECT_EQ(seen.size() + src.drops, 200u);  // every announced frame: delivered or counted
+  EXPECT_NE(src.status.find(std::to_string(src.drops) + " corrupt frames skipped"),
+            std::string::npos)
+      << src.status;
+  EXPECT_GT(seen.back().header.frame, 180);  // not an early end
+  for (std::size_t i = 0; i < seen.size(); ++i) EXPECT_EQ(seen[i].header.seq, i);
+}
+
+// loop: the clip starts again at its end; sequence numbers and offline stamps go on counting.
+TEST(VideoSourceNode, LoopStartsAgainAtTheEndWithSequenceAndTimeGoingOn) {
+  if (!fs::exists(kVtestPart)) GTEST_SKIP() << "shared video absent: " << kVtestPart;
+  seen.clear();
+  const RunResult result = testing::run_graph(
+      graph_yaml("path: " + kVtestPart + ", mode: offline, loop: true, count: 450"));
+  ASSERT_TRUE(result.ok) << result.error;
+  ASSERT_EQ(seen.size(), 450u);
+  for (std::size_t i = 0; i < seen.size(); ++i) {
+    EXPECT_EQ(seen[i].header.seq, i);
+    EXPECT_EQ(seen[i].header.frame, static_cast<std::int64_t>(i % 200));
+    EXPECT_NEAR(static_cast<double>(seen[i].header.capture_ns) * 1e-9, 0.1 * i, 0.011);
+  }
+  EXPECT_NE(testing::stats_of(result, "src").status.find("started again 2 times"),
+            std::string::npos);
+}
+
 TEST(VideoSourceNode, AnAbsentCameraStopsTheGraphWithAClearError) {
   if (fs::exists("/dev/video9")) GTEST_SKIP() << "/dev/video9 exists on this machine";
   const RunResult result = testing::run_graph(graph_yaml("path: /dev/video9"));

@@ -8,6 +8,10 @@
 // time has already passed when the next one is due is skipped (counted as this node's drop).
 // Live frames are stamped with their capture time (CLOCK_REALTIME). Either way, put a `latest` edge
 // after this node so that a slow consumer takes the newest frame.
+//
+// loop: a file or folder starts again at its end (soak tests, installations); sequence numbers
+// go on counting, offline stamps go on from the end of the previous pass. Damaged frames that
+// FFmpeg could not decode are skipped: counted as drops, logged and shown in the status line.
 
 #include <cmath>
 #include <iostream>
@@ -40,6 +44,7 @@ class VideoSourceNode : public Node {
     c.param<int>("timeout_ms", 10000, "network streams: open and read timeout", {100, 600000});
     c.param<int>("camera", 0, "camera id in the messages", {0, 1000});
     c.param<std::string>("stream", "", "stream id of the messages (default: the path)");
+    c.param<bool>("loop", false, "files and folders: start again at the end (counts the passes)");
   }
 
   void open(Context& ctx) override {
@@ -51,6 +56,8 @@ class VideoSourceNode : public Node {
     options.height = ctx.param<int>("height");
     options.timeout_ms = ctx.param<int>("timeout_ms");
     const std::string path = ctx.param<std::string>("path");
+    path_ = path;
+    options_ = options;
     source_.emplace(path, options);
     const std::string mode = ctx.param<std::string>("mode");
     if (mode == "auto") {
@@ -61,6 +68,7 @@ class VideoSourceNode : public Node {
       throw std::invalid_argument("mode must be offline, live or auto, not '" + mode + "'");
     }
     count_ = ctx.param<std::uint64_t>("count");
+    loop_ = ctx.param<bool>("loop") && !source_->live();
     camera_id_ = ctx.param<int>("camera");
     stream_ = ctx.param<std::string>("stream");
     if (stream_.empty()) stream_ = path;
@@ -84,10 +92,17 @@ class VideoSourceNode : public Node {
     } else {
       frame = source_->read();
     }
-    if (!frame) return ctx.finish();
+    if (!frame) {
+      if (ctx.stop_requested()) return;  // woken from a paced wait: not the end of the file
+      count_undecodable(ctx);
+      if (!loop_ || source_->frames_read() == 0) return ctx.finish();
+      return start_next_pass(ctx);  // the next call reads its first frame
+    }
     // Offline, a file's or folder's frames are stamped with their time in the source (from 0),
     // so that outputs say where in the video they are; live, with the capture (wall) time.
-    const std::int64_t stamp = live_ ? frame->capture_ns : std::llround(frame->media_time_s * 1e9);
+    const std::int64_t stamp =
+        live_ ? frame->capture_ns : std::llround((pass_offset_s_ + frame->media_time_s) * 1e9);
+    last_media_time_s_ = frame->media_time_s;
     VideoFrame message;
     message.header = {stream_, sent_, stamp, frame->index};
     message.camera_id = camera_id_;
@@ -99,10 +114,32 @@ class VideoSourceNode : public Node {
   void close(Context& ctx) override {
     if (!source_) return;
     std::cerr << ctx.node_name() << ": " << sent_ << " frames sent, " << skipped_
-              << " skipped (late)\n";
+              << " skipped (late), " << undecodable_ << " corrupt frames skipped";
+    if (loop_) std::cerr << ", started again " << loops_ << " times";
+    std::cerr << "\n";
   }
 
  private:
+  // At the end of a pass: frames the file announced but FFmpeg could not decode.
+  void count_undecodable(Context& ctx) {
+    const std::int64_t missing = source_->frames_undecodable();
+    if (missing <= 0) return;
+    undecodable_ += static_cast<std::uint64_t>(missing);
+    for (std::int64_t i = 0; i < missing; ++i) ctx.count_drop();
+    std::cerr << ctx.node_name() << ": " << missing << " corrupt frames skipped in " << path_
+              << " (" << undecodable_ << " so far)\n";
+    ctx.report_status(std::to_string(undecodable_) + " corrupt frames skipped");
+  }
+  // Opens the file or folder again.
+  void start_next_pass(Context& ctx) {
+    const double period = source_->fps() > 0 ? 1.0 / source_->fps() : 1.0 / 30.0;
+    pass_offset_s_ += last_media_time_s_ + period;
+    source_.emplace(path_, options_);
+    start_ns_ = 0;
+    ++loops_;
+    if (undecodable_ == 0) ctx.report_status("started again " + std::to_string(loops_) + " times");
+  }
+
   // A file or folder replayed like a camera: frame i is due at start + its media time. Frames
   // already overdue when the one after them is due are passed over without conversion.
   std::optional<video::Frame> paced_read(Context& ctx) {
@@ -129,7 +166,11 @@ class VideoSourceNode : public Node {
   }
 
   std::optional<video::VideoSource> source_;
-  bool live_ = false;
+  std::string path_;
+  video::SourceOptions options_;
+  bool live_ = false, loop_ = false;
+  std::uint64_t undecodable_ = 0, loops_ = 0;
+  double pass_offset_s_ = 0.0, last_media_time_s_ = 0.0;
   std::uint64_t count_ = 0, sent_ = 0, skipped_ = 0;
   std::int64_t start_ns_ = 0;
   int camera_id_ = 0;
