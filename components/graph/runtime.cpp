@@ -9,6 +9,7 @@
 #include <thread>
 
 #include "graph/inbox.hpp"
+#include "graph/sequence_check.hpp"
 #include "graph/transport.hpp"
 
 namespace mocap::graph {
@@ -19,12 +20,15 @@ constexpr auto kAcknowledgementTimeout = std::chrono::milliseconds(30000);
 
 class NodeRunner;
 
-// One ZeroMQ edge arriving in this process: a thread that receives, decodes and queues.
+// One ZeroMQ edge arriving in this process: a thread that receives, decodes, checks the sequence
+// numbers and queues.
 struct IncomingEdge {
   std::string name;
   std::unique_ptr<Receiver> receiver;
+  NodeRunner* consumer = nullptr;
   Inbox* inbox = nullptr;
   std::size_t port = 0;
+  SequenceCheck sequence;
   std::thread thread;
 };
 
@@ -90,6 +94,7 @@ struct Runtime::Impl {
   void add_sending_half(const EdgeSpec& edge);
   NodeRunner* runner(std::string_view name) const;
   void receive_loop(IncomingEdge& edge);
+  void check_sequence(IncomingEdge& edge, const Header& header, bool end);
   GraphStats snapshot() const;
   void join_nodes();
   void wait_for_acknowledgements();
@@ -121,6 +126,8 @@ class NodeRunner final : public Context {
     std::string type;  // resolved message type, empty when any
     std::vector<std::pair<Inbox*, std::size_t>> local;
     std::vector<RemoteOutput> remote;
+    Header last_sent;  // of the last message, for the end of stream on ZeroMQ edges
+    bool sent_any = false;
   };
 
   NodeRunner(Runtime::Impl& runtime, const ResolvedNode& node, std::vector<EdgePolicy> policies,
@@ -155,7 +162,7 @@ class NodeRunner final : public Context {
     bool all_acknowledged = true;
     for (Output& out : outputs_) {
       for (RemoteOutput& remote : out.remote) {
-        if (resend) remote.sender->send(Packet::end_of_stream(), [] { return true; });
+        if (resend) remote.sender->send(end_of_stream(out), [] { return true; });
         all_acknowledged = remote.sender->poll_acknowledgement() && all_acknowledged;
       }
     }
@@ -232,6 +239,16 @@ class NodeRunner final : public Context {
   void run_consumer();
   void timed_process();
   void end_outputs();
+  // The end of stream this node sends: its header names the stream and, as seq, how many
+  // messages of it were sent (the last seq + 1), so that a consumer in another process can tell
+  // that messages are missing at the end (a killed peer). A node that sent nothing passes on the
+  // header of the end of stream it received.
+  Packet end_of_stream(const Output& out) const {
+    if (!out.sent_any) return Packet::end_of_stream(received_end_);
+    Header header = out.last_sent;
+    ++header.seq;
+    return Packet::end_of_stream(std::move(header));
+  }
   void record_failure(const char* stage, const std::string& what) {
     runtime_.fail("node '" + node_.name + "' (" + node_.type->name + ") failed in " + stage + ": " +
                   what);
@@ -252,6 +269,7 @@ class NodeRunner final : public Context {
   const Packet* current_ = nullptr;
   std::size_t current_port_ = 0;
   bool finished_ = false, failed_ = false;
+  Header received_end_;  // the header of an end of stream that arrived
   Clock::duration slept_{};
 
   std::atomic<std::uint64_t> in_{0}, out_{0}, own_drops_{0};
@@ -281,6 +299,10 @@ void NodeRunner::send_packet(std::string_view port, Packet packet) {
     const auto give_up = [&] { return remote.lossy || runtime_.drain_expired(); };
     if (!remote.sender->send(packet, give_up)) ++own_drops_;
   }
+  if (!out.remote.empty()) {
+    out.last_sent = packet.header();
+    out.sent_any = true;
+  }
   ++out_;
 }
 
@@ -301,6 +323,7 @@ void NodeRunner::run_consumer() {
   if (connected_inputs_ == 0) return;  // only optional, unconnected inputs: nothing will come
   while (auto delivery = inbox_.pop()) {
     if (delivery->packet.is_end_of_stream()) {
+      if (!delivery->packet.header().stream.empty()) received_end_ = delivery->packet.header();
       if (++ended == connected_inputs_) return;
       continue;
     }
@@ -342,8 +365,8 @@ void NodeRunner::run() {
 }
 
 void NodeRunner::end_outputs() {
-  const Packet eos = Packet::end_of_stream();
   for (Output& out : outputs_) {
+    const Packet eos = end_of_stream(out);
     for (auto& [inbox, input] : out.local) inbox->push(input, eos);
     for (RemoteOutput& remote : out.remote) {
       if (!remote.sender->send(eos, [&] { return runtime_.drain_expired(); })) {
@@ -383,6 +406,7 @@ void Runtime::Impl::add_receiving_half(const EdgeSpec& edge) {
   incoming_edge->name = edge.str() + " (" + edge.transport + ")";
   incoming_edge->receiver =
       std::make_unique<Receiver>(transport, edge.transport, socket_options(edge));
+  incoming_edge->consumer = to;
   incoming_edge->inbox = &to->inbox();
   incoming_edge->port =
       static_cast<std::size_t>(to->resolved().type->contract.input_index(edge.to.port));
@@ -467,12 +491,27 @@ void Runtime::Impl::receive_loop(IncomingEdge& edge) {
     }
     if (!result.message) continue;
     const bool eos = result.message->packet.is_end_of_stream();
+    check_sequence(edge, result.message->packet.header(), eos);
     if (!edge.inbox->push(edge.port, std::move(result.message->packet))) return;  // consumer gone
     if (eos) {
       edge.receiver->acknowledge_end();
       return;
     }
   }
+}
+
+// Messages missed on an edge (a peer killed and restarted, a lost connection, drops upstream) or
+// a stream started again are reported, never silent: a log line (the first few, then every
+// 1000th) and the consumer's status line in the statistics.
+void Runtime::Impl::check_sequence(IncomingEdge& edge, const Header& header, bool end) {
+  const std::optional<SequenceEvent> event =
+      end ? edge.sequence.check_end(header) : edge.sequence.check(header);
+  if (!event) return;
+  const std::string text = describe(*event, edge.name, edge.sequence);
+  const std::uint64_t events =
+      edge.sequence.gaps() + edge.sequence.restarts() + edge.sequence.joins();
+  if (events <= 5 || events % 1000 == 0) log(text);
+  edge.consumer->report_status(text);
 }
 
 // Joins node threads as they finish. Meanwhile, nodes that have ended keep repeating their end of
