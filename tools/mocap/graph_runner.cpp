@@ -1,6 +1,7 @@
 #include "graph_runner.hpp"
 
 #include <condition_variable>
+#include <csignal>
 #include <cstdlib>
 #include <iostream>
 #include <mutex>
@@ -36,6 +37,9 @@ class StopRelay {
 graph::RunResult run_graph_here(const graph::ResolvedGraph& graph, graph::RunOptions options,
                                 const std::string& label, const ProgressCallback& progress,
                                 std::chrono::milliseconds every) {
+  // A file over the size limit (`ulimit -f`) makes the write fail with EFBIG, which the sink
+  // reports naming the file, instead of SIGXFSZ ending the process without a word.
+  std::signal(SIGXFSZ, SIG_IGN);
   StopRelay relay;
   graph::SignalWatcher watcher([&](int, int count) {
     if (count > 1) {

@@ -7,7 +7,9 @@
 // with normal . p + offset = 0, normal up). Each line is flushed as it is written, so the file
 // holds every finished frame even if the run is killed.
 
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <memory>
 
 #include <nlohmann/json.hpp>
@@ -28,7 +30,8 @@ class JsonLinesSink : public Node {
   void open(Context& ctx) override {
     path_ = ctx.param<std::string>("path");
     file_.reset(std::fopen(path_.c_str(), "w"));
-    if (!file_) throw InputError(path_, "cannot create the file");
+    if (!file_)
+      throw InputError(path_, std::string("cannot create the file: ") + std::strerror(errno));
   }
   void process(Context& ctx) override {
     const auto& in = ctx.input<People3D>("in");
@@ -48,7 +51,8 @@ class JsonLinesSink : public Node {
     const std::string text = line.dump() + "\n";
     if (std::fwrite(text.data(), 1, text.size(), file_.get()) != text.size() ||
         std::fflush(file_.get()) != 0) {
-      throw InputError(path_, "write failed (disk full?)");
+      throw InputError(path_, std::string("write failed: ") + std::strerror(errno) +
+                                  " (disk full or over the file size limit?)");
     }
   }
   void close(Context&) override { file_.reset(); }
