@@ -116,7 +116,7 @@ try {
   }
   if (args.screenshot) await page.screenshot({ path: args.screenshot });
   if (duration > 0) {
-    // The page's own counters, once a second; the first second is dropped (start-up).
+    // The page's own counters (its last full second), read once a second; medians reported.
     const samples = [], renderSamples = [];
     const received0 = frames.length, t0 = Date.now();
     for (let s = 0; s < duration; ++s) {
