@@ -299,6 +299,20 @@ TEST(VmcSink, APortIsGivenToTheNextPersonAfterReleaseTime) {
   }
 }
 
+// person: an id sends that person only (person 5 is in frames 5-19); first keeps person 3.
+TEST(VmcSink, PersonChoiceByIdAndFirst) {
+  MOCAP_REQUIRE_SMALL_DATABASE(db);
+  for (const auto& [choice, expected] : {std::pair{"5", 15u}, std::pair{"first", 20u}}) {
+    OscReceiver receiver;
+    ASSERT_TRUE(receiver.ok());
+    const graph::RunResult result = run_graph(vmc_graph(
+        db, script(20), "port: " + std::to_string(receiver.port()) + ", person: " + choice));
+    ASSERT_TRUE(result.ok) << result.error;
+    receiver.wait_for(expected);
+    EXPECT_EQ(receiver.bundle_count(), expected) << "person " << choice;
+  }
+}
+
 TEST(VmcSink, UnknownPersonChoiceIsRefusedNamingTheNode) {
   MOCAP_REQUIRE_SMALL_DATABASE(db);
   const graph::RunResult result = run_graph(vmc_graph(db, "1:0:0:0", "person: tallest"));
