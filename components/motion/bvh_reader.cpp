@@ -130,7 +130,14 @@ void parse_joint(Tokenizer& tok, Skeleton& skel, int parent, bool end_site, int 
     tok.expect("CHANNELS");
     const long n = tok.integer("the channel count");
     if (n < 0 || n > 6) tok.fail("channel count must be 0 to 6, found " + std::to_string(n));
-    for (long c = 0; c < n; ++c) joint.channels.push_back(parse_channel(tok));
+    for (long c = 0; c < n; ++c) {
+      const Channel channel = parse_channel(tok);
+      // A channel named twice leaves its meaning (and the rotation order) undefined.
+      if (std::find(joint.channels.begin(), joint.channels.end(), channel) != joint.channels.end())
+        tok.fail(std::string("channel ") + channel_name(channel) + " listed twice for joint '" +
+                 joint.name + "'");
+      joint.channels.push_back(channel);
+    }
   }
   skel.joints.push_back(std::move(joint));
   for (;;) {

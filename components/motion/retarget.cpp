@@ -332,6 +332,11 @@ constexpr float kMaxOffset = 1e5f;
 
 void check_offsets(const Skeleton& skeleton, const std::string& name) {
   for (const SkeletonJoint& j : skeleton.joints) {
+    // The result is written as Euler angles in the joint's own order: three axes or none.
+    const auto rotations = std::count_if(j.channels.begin(), j.channels.end(), is_rotation);
+    if (rotations != 0 && rotations != 3)
+      throw InputError(name, "joint '" + j.name + "' has " + std::to_string(rotations) +
+                                 " rotation channels; retargeting needs 0 or 3");
     for (int i = 0; i < 3; ++i) {
       if (!(std::abs(j.offset[i]) <= kMaxOffset))
         throw InputError(name, "joint '" + j.name + "' has an OFFSET beyond " +
