@@ -47,4 +47,15 @@ void Contract::add_param(ParamSpec param) {
   params_.push_back(std::move(param));
 }
 
+void Contract::network_socket(std::string endpoint_param, std::string bind_param) {
+  if (network_) throw std::logic_error("network_socket() declared twice");
+  param<std::string>("curve_server", "",
+                     "CURVE: the binding end's key file (NAME.key where it binds, NAME.pub where "
+                     "it connects); required beyond loopback (docs/security.md)");
+  param<std::string>("curve_client", "",
+                     "CURVE: the client key files (binding: NAME.pub or folders of *.pub, "
+                     "comma-separated, the only clients let in; connecting: its own NAME.key)");
+  network_ = NetworkSocket{std::move(endpoint_param), std::move(bind_param)};
+}
+
 }  // namespace mocap::graph

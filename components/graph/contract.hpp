@@ -3,6 +3,7 @@
 // types and parameters with type, default, range and a one-line doc. The framework checks graphs
 // against contracts before any node runs, and `mocap graph inspect` prints them.
 
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -60,6 +61,13 @@ class Contract {
     add_param(ParamSpec{std::move(name), param_type_of<T>(), std::nullopt, range, std::move(doc)});
   }
 
+  // The node opens a ZeroMQ socket itself, at the endpoint in parameter `endpoint_param`; it binds
+  // unless `bind_param` names a bool parameter set to false. This adds the parameters
+  // `curve_server` and `curve_client` (key file references, docs/security.md), and validation
+  // applies the network rules to the endpoint (loopback unless allowed; keys beyond loopback) and
+  // resolves the references, which the node hands to load_curve_keys (graph/keys.hpp).
+  void network_socket(std::string endpoint_param, std::string bind_param = {});
+
   // Sources only: instead of ending by itself, the node runs until every node that does not
   // depend on it has finished (a statistics reporter, a heartbeat).
   void runs_until_graph_ends() { auxiliary_ = true; }
@@ -69,6 +77,10 @@ class Contract {
   const std::vector<PortSpec>& outputs() const { return outputs_; }
   const std::vector<ParamSpec>& params() const { return params_; }
   bool auxiliary() const { return auxiliary_; }
+  struct NetworkSocket {
+    std::string endpoint_param, bind_param;
+  };
+  const std::optional<NetworkSocket>& network() const { return network_; }
   bool is_source() const { return inputs_.empty(); }
 
   int input_index(std::string_view name) const;   // -1 when unknown
@@ -97,6 +109,7 @@ class Contract {
   std::vector<PortSpec> inputs_, outputs_;
   std::vector<ParamSpec> params_;
   bool auxiliary_ = false;
+  std::optional<NetworkSocket> network_;
 };
 
 }  // namespace mocap::graph

@@ -9,6 +9,7 @@
 
 #include "core/input_error.hpp"
 #include "graph/graph_spec.hpp"
+#include "graph/keys.hpp"
 
 namespace mocap::graph {
 
@@ -118,7 +119,8 @@ class Reader {
 
   void edge_options(const YAML::Node& options, EdgeSpec& edge) const {
     expect_map(options, "edge options");
-    only_keys(options, {"policy", "transport", "from", "to"}, "an edge");
+    only_keys(options, {"policy", "transport", "curve", "from", "to"}, "an edge");
+    if (const YAML::Node curve = options["curve"]) edge.curve = curve_spec(curve);
     if (const YAML::Node policy = options["policy"]) {
       const std::string text = scalar(policy, "policy");
       const auto parsed = parse_policy(text);
@@ -138,6 +140,32 @@ class Reader {
                             "' must be in-process or an inproc://, ipc:// or tcp:// endpoint");
       }
     }
+  }
+
+  std::string key_reference(const YAML::Node& node) const {
+    const std::string text = scalar(node, "a key reference");
+    if (const std::string problem = key_reference_problem(text); !problem.empty()) {
+      fail(node, "curve: " + problem);
+    }
+    return resolve_key_reference(text, std::filesystem::path(file_).parent_path());
+  }
+
+  // curve: { server: REF, client: REF }
+  CurveSpec curve_spec(const YAML::Node& node) const {
+    CurveSpec spec;
+    spec.where = at(node);
+    if (!node.IsMap()) {
+      fail(node, "curve must be { server: KEYFILE, client: KEYFILE } (key files, not keys)");
+    }
+    only_keys(node, {"server", "client"}, "curve");
+    if (!node["server"] || !node["client"]) {
+      fail(node, "curve needs server: (the consumer's key) and client: (the producer's key)");
+    }
+    spec.server = key_reference(node["server"]);
+    // An edge has one producer, so one client key: it is both what the producer connects with
+    // and the only key the consumer lets in.
+    spec.clients.push_back(key_reference(node["client"]));
+    return spec;
   }
 
   // [from, to] or [from, to, {options}] or {from: .., to: .., policy: .., transport: ..}

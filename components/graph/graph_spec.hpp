@@ -37,10 +37,23 @@ struct PortRef {
   std::string str() const { return node + "." + port; }
 };
 
+// ZeroMQ CURVE of an edge (`curve: { server: keys/solve, client: keys/capture }`): key file
+// references (graph/keys.hpp), already resolved against the graph file's folder. The consumer
+// binds and is the server (SERVER.key; it lets in only the CLIENT.pub keys, or every *.pub of a
+// client folder); the producer connects with SERVER.pub and CLIENT.key.
+struct CurveSpec {
+  std::string server;
+  std::vector<std::string> clients;
+  SourceLocation where;
+
+  bool enabled() const { return !server.empty(); }
+};
+
 struct EdgeSpec {
   PortRef from, to;
   EdgePolicy policy;
   std::string transport;  // empty: in-process; else a ZeroMQ endpoint (inproc://, ipc://, tcp://)
+  CurveSpec curve;        // keys of a transport edge; disabled when not given
   SourceLocation where;
 
   std::string str() const { return from.str() + " -> " + to.str(); }
@@ -76,6 +89,9 @@ struct GraphSpec {
   std::vector<ProcessSpec> processes;
   std::vector<PluginSpec> plugins;
   bool allow_network = false;  // tcp:// endpoints beyond loopback need `allow_network: true`
+  // Set by `mocap run --process NAME` before validation: only the key files this process reads
+  // are checked (the other ends may be on other hosts with their own files). Empty: all.
+  std::string local_process;
 
   const NodeSpec* find_node(std::string_view name) const;
   // The process a node is placed in; empty when the graph has no placement.

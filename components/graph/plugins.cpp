@@ -1,8 +1,11 @@
 #include "graph/plugins.hpp"
 
 #include <dlfcn.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -24,6 +27,27 @@ std::string last_dl_error() {
 }
 
 }  // namespace
+
+void check_plugin_path_safe(const std::string& path) {
+  struct stat info {};
+  if (stat(path.c_str(), &info) != 0) return;  // dlopen or the listing names what is missing
+  const char* what = S_ISDIR(info.st_mode) ? "plugin folder " : "plugin ";
+  // Sticky folders (/tmp) let others add files too, so they are refused like any other.
+  if (info.st_mode & (S_IWGRP | S_IWOTH)) {
+    char mode[8];
+    std::snprintf(mode, sizeof mode, "%04o", static_cast<unsigned>(info.st_mode & 07777));
+    throw std::runtime_error(std::string(what) + path + " is writable by " +
+                             ((info.st_mode & S_IWOTH) ? "others" : "its group") + " (mode " +
+                             mode +
+                             "): anyone who can write it could run code in this program; "
+                             "refused (chmod go-w it)");
+  }
+  if (info.st_uid != 0 && info.st_uid != geteuid()) {
+    throw std::runtime_error(std::string(what) + path + " belongs to another user (uid " +
+                             std::to_string(info.st_uid) +
+                             "), who could change it to run code in this program; refused");
+  }
+}
 
 namespace {
 
@@ -48,6 +72,10 @@ void load_plugin(const std::string& path) {
     return;
   }
 
+  // Neither the file nor the folder it is in may be open to others: they could swap the code.
+  check_plugin_path_safe(canonical);
+  check_plugin_path_safe(std::filesystem::path(canonical).parent_path().string());
+
   // Registration runs in the library's static initialisers, inside dlopen.
   Registry::instance().set_origin(canonical);
   LibraryHandle handle{dlopen(canonical.c_str(), RTLD_NOW | RTLD_LOCAL)};
@@ -69,6 +97,7 @@ void load_plugins_from(const std::string& file_or_directory) {
     load_plugin(file_or_directory);
     return;
   }
+  check_plugin_path_safe(fs::weakly_canonical(file_or_directory).string());
   std::vector<fs::path> libraries;
   for (const auto& entry : fs::directory_iterator(file_or_directory)) {
     if (entry.is_regular_file() && entry.path().extension() == ".so")

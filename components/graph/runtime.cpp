@@ -9,6 +9,7 @@
 #include <thread>
 
 #include "graph/inbox.hpp"
+#include "graph/keys.hpp"
 #include "graph/sequence_check.hpp"
 #include "graph/transport.hpp"
 
@@ -89,7 +90,7 @@ struct Runtime::Impl {
 
   void build();
   bool uses_transport(const EdgeSpec& edge) const;
-  SocketOptions socket_options(const EdgeSpec& edge) const;
+  SocketOptions socket_options(const EdgeSpec& edge, bool binds) const;
   void add_receiving_half(const EdgeSpec& edge);
   void add_sending_half(const EdgeSpec& edge);
   NodeRunner* runner(std::string_view name) const;
@@ -390,11 +391,15 @@ bool Runtime::Impl::uses_transport(const EdgeSpec& edge) const {
   return !edge.transport.empty() && !options.single_process;
 }
 
-SocketOptions Runtime::Impl::socket_options(const EdgeSpec& edge) const {
+SocketOptions Runtime::Impl::socket_options(const EdgeSpec& edge, bool binds) const {
   SocketOptions socket;
   // Lossy edges drain the socket at once and decide what to drop in the inbox, where it is
   // counted; blocking edges let ZeroMQ queue only as much as the edge allows.
   socket.high_water_mark = static_cast<int>(edge.policy.lossy() ? 1000 : edge.policy.capacity);
+  // CURVE (docs/security.md): the consumer binds and is the server.
+  if (edge.curve.enabled()) {
+    socket.curve = load_curve_keys(edge.curve.server, edge.curve.clients, binds);
+  }
   return socket;
 }
 
@@ -405,7 +410,7 @@ void Runtime::Impl::add_receiving_half(const EdgeSpec& edge) {
   auto incoming_edge = std::make_unique<IncomingEdge>();
   incoming_edge->name = edge.str() + " (" + edge.transport + ")";
   incoming_edge->receiver =
-      std::make_unique<Receiver>(transport, edge.transport, socket_options(edge));
+      std::make_unique<Receiver>(transport, edge.transport, socket_options(edge, true));
   incoming_edge->consumer = to;
   incoming_edge->inbox = &to->inbox();
   incoming_edge->port =
@@ -421,7 +426,7 @@ void Runtime::Impl::add_sending_half(const EdgeSpec& edge) {
       static_cast<std::size_t>(from->resolved().type->contract.output_index(edge.from.port)));
   if (uses_transport(edge)) {
     out.remote.push_back({std::make_unique<Sender>(transport, edge.transport, Sender::Pattern::edge,
-                                                   socket_options(edge)),
+                                                   socket_options(edge, false)),
                           edge.policy.lossy()});
     return;
   }

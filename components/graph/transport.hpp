@@ -13,12 +13,17 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
+#include <vector>
 
 #include "graph/wire_format.hpp"
 
 namespace mocap::graph {
 
-// One per process; outlives every socket made from it.
+// One per process; outlives every socket made from it. When a socket of it is a CURVE server,
+// the context also runs the guard: a thread answering ZeroMQ's authentication requests (ZAP, on
+// inproc://zeromq.zap.01) from the sockets' allow-lists, and watching the sockets' handshakes, so
+// that every refused connection is logged on stderr (rate-limited) and counted.
 class TransportContext {
  public:
   TransportContext();
@@ -29,16 +34,44 @@ class TransportContext {
   struct Impl;
   Impl& impl() { return *impl_; }
   void* native_handle();  // the zmq context (void*), for tests that speak raw ZeroMQ
+  // Connections refused so far: a client key not on the allow-list, a failed CURVE handshake (no
+  // keys, a wrong server key), or, on a connecting socket, a server that refused this one.
+  std::uint64_t refused_connections() const;
 
  private:
   std::unique_ptr<Impl> impl_;
+};
+
+// ZeroMQ CURVE keys of one socket, Z85 text (40 characters each; docs/security.md). The end that
+// binds is the CURVE server: its own secret key, and the public keys of the clients it lets in
+// (no others). The end that connects is a client: its own secret key and the server's public key.
+struct CurveKeys {
+  std::string secret_key;                    // this socket's own secret key; empty: no CURVE
+  std::string server_public_key;             // connecting sockets: the server's public key
+  std::vector<std::string> allowed_clients;  // binding sockets: the clients' public keys
+
+  bool enabled() const { return !secret_key.empty(); }
 };
 
 struct SocketOptions {
   int high_water_mark = 16;  // messages queued per socket before the sender waits (or drops)
   int linger_ms = 1000;      // how long unsent messages may delay closing
   std::int64_t max_message_bytes = std::int64_t{512} << 20;  // larger frames drop the connection
+  CurveKeys curve;                                           // empty: plain ZeroMQ
 };
+
+// True when this libzmq was built with CURVE (Debian's is, through libsodium).
+bool curve_available();
+struct CurveKeyPair {
+  std::string public_key, secret_key;  // Z85, 40 characters each
+};
+// A fresh key pair from libsodium's random source. Throws std::runtime_error without CURVE.
+CurveKeyPair generate_curve_key_pair();
+// The public key that belongs to a secret key. Throws std::runtime_error when `secret_key` is not
+// a Z85 key.
+std::string curve_public_key(const std::string& secret_key);
+// 40 characters of the Z85 alphabet: what a CURVE key looks like as text.
+bool looks_like_z85_key(std::string_view text);
 
 class Sender {
  public:

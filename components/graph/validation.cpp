@@ -1,12 +1,15 @@
 #include "graph/validation.hpp"
 
 #include <algorithm>
+#include <filesystem>
 #include <regex>
 #include <set>
 #include <sstream>
 
 #include "core/input_error.hpp"
+#include "graph/keys.hpp"
 #include "graph/plugins.hpp"
+#include "graph/transport.hpp"
 
 namespace mocap::graph {
 
@@ -32,6 +35,7 @@ class Checker {
     resolve_types(order);
     check_placement();
     check_transports();
+    check_network_nodes();
     if (!errors_.empty()) {
       std::string message;
       for (const auto& e : errors_) message += (message.empty() ? "" : "\n") + e;
@@ -262,26 +266,190 @@ class Checker {
     }
   }
 
+  // What an endpoint says about the network: tcp:// to anything but loopback leaves the machine
+  // (`*`, 0.0.0.0 and [::] listen on every interface).
+  struct Endpoint {
+    bool tcp = false, malformed = false, beyond_loopback = false, inproc = false;
+    std::string host;
+  };
+  static Endpoint endpoint_of(const std::string& text) {
+    static const std::regex tcp(R"(tcp://(\[[^\]]+\]|[^:]+):(\d+|\*))");
+    Endpoint e;
+    e.inproc = text.rfind("inproc://", 0) == 0;
+    if (text.rfind("tcp://", 0) != 0) return e;
+    e.tcp = true;
+    std::smatch match;
+    if (!std::regex_match(text, match, tcp)) {
+      e.malformed = true;
+      return e;
+    }
+    e.host = match[1].str();
+    e.beyond_loopback = !(e.host == "localhost" || e.host == "[::1]" ||
+                          e.host.rfind("127.", 0) == 0 || e.host == "lo");
+    return e;
+  }
+
+  bool local(const std::string& process) const {
+    return spec_.local_process.empty() || process.empty() || process == spec_.local_process;
+  }
+
+  // Reads the key files an end of a CURVE socket will read, reporting every problem at `where`.
+  void check_key_files(const SourceLocation& where, const std::string& server,
+                       const std::vector<std::string>& clients, bool check_binder,
+                       bool check_connector) {
+    if (!curve_available()) {
+      error(where,
+            "CURVE keys are given, but this libzmq has no CURVE security (zmq_has(\"curve\") is "
+            "false: install a libzmq built with libsodium)");
+      return;
+    }
+    auto attempt = [&](auto&& read) {
+      try {
+        read();
+      } catch (const std::exception& e) {
+        error(where, e.what());
+      }
+    };
+    if (check_binder) {
+      attempt([&] { read_secret_key_file(server + ".key"); });
+      for (const std::string& client : clients) attempt([&] { read_public_keys(client); });
+    }
+    if (check_connector) {
+      attempt([&] { read_public_key_file(server + ".pub"); });
+      if (clients.size() != 1) {
+        error(where, "the connecting end needs exactly one client key (its own), not " +
+                         std::to_string(clients.size()));
+      } else {
+        attempt([&] { read_secret_key_file(clients.front() + ".key"); });
+      }
+    }
+  }
+
   void check_transports() {
-    static const std::regex tcp(R"(tcp://(\[[^\]]+\]|[^:]+):(\d+))");
     std::map<std::string, const EdgeSpec*> used;
     for (const EdgeSpec& edge : spec_.edges) {
-      if (edge.transport.empty()) continue;
+      if (edge.transport.empty()) {
+        if (edge.curve.enabled()) {
+          error(edge.curve.where,
+                "edge " + edge.str() + ": curve keys need an ipc:// or tcp:// transport");
+        }
+        continue;
+      }
       if (const auto [it, fresh] = used.emplace(edge.transport, &edge); !fresh) {
         error(edge.where, "endpoint " + edge.transport + " is already used by the edge at " +
                               it->second->where.str());
       }
-      std::smatch match;
-      if (edge.transport.rfind("tcp://", 0) != 0) continue;
-      if (!std::regex_match(edge.transport, match, tcp)) {
+      const Endpoint endpoint = endpoint_of(edge.transport);
+      if (endpoint.inproc && edge.curve.enabled()) {
+        error(edge.curve.where,
+              "edge " + edge.str() +
+                  ": curve keys need an ipc:// or tcp:// transport, not inproc://");
+      }
+      if (endpoint.malformed) {
         error(edge.where, "tcp endpoint '" + edge.transport + "' must be tcp://host:port");
         continue;
       }
-      const std::string host = match[1].str();
-      const bool loopback = host == "127.0.0.1" || host == "localhost" || host == "[::1]";
-      if (!loopback && !spec_.allow_network) {
-        error(edge.where, "edge " + edge.str() + " listens beyond this machine (" + host +
+      if (endpoint.beyond_loopback && !spec_.allow_network) {
+        error(edge.where, "edge " + edge.str() + " listens beyond this machine (" + endpoint.host +
                               "); set 'allow_network: true' in the graph to allow it");
+      }
+      if (endpoint.beyond_loopback && !edge.curve.enabled()) {
+        error(edge.where, "edge " + edge.str() + " crosses the network (" + endpoint.host +
+                              ") without keys: add curve: { server: KEYFILE, client: KEYFILE } "
+                              "to it (see docs/security.md, 'mocap keys generate')");
+      }
+      if (edge.curve.enabled()) {
+        check_key_files(edge.curve.where, edge.curve.server, edge.curve.clients,
+                        local(spec_.process_of(edge.to.node)),
+                        local(spec_.process_of(edge.from.node)));
+      }
+    }
+  }
+
+  // Nodes that open sockets themselves (Contract::network_socket): the same rules as edges, with
+  // the keys in the parameters curve_server and curve_client.
+  void check_network_nodes() {
+    for (ResolvedNode& node : nodes_) {
+      if (!node.type || !node.type->contract.network()) continue;
+      const Contract::NetworkSocket& socket = *node.type->contract.network();
+      const NodeSpec& spec = *spec_.find_node(node.name);
+      const auto text = [&](const std::string& param) -> std::string {
+        const auto it = node.params.find(param);
+        if (it == node.params.end()) return {};
+        const auto* value = std::get_if<std::string>(&it->second);
+        return value ? *value : std::string();
+      };
+      const auto where = [&](const std::string& param) {
+        const auto it = spec.params.find(param);
+        return it == spec.params.end() ? spec.where : it->second.where;
+      };
+      const std::string endpoint_text = text(socket.endpoint_param);
+      if (endpoint_text.empty()) continue;  // a missing required parameter, already reported
+      bool binds = true;
+      if (!socket.bind_param.empty()) {
+        const auto it = node.params.find(socket.bind_param);
+        if (it != node.params.end() && std::holds_alternative<bool>(it->second)) {
+          binds = std::get<bool>(it->second);
+        }
+      }
+      // Key references: relative ones against the graph file's folder (--set: the current one).
+      std::vector<std::string> clients;
+      std::string server, joined;
+      bool references_ok = true;
+      const auto resolve_one = [&](const std::string& param, std::string reference) {
+        const auto first = reference.find_first_not_of(" \t");
+        const auto last = reference.find_last_not_of(" \t");
+        reference = first == std::string::npos ? "" : reference.substr(first, last - first + 1);
+        if (const std::string problem = key_reference_problem(reference); !problem.empty()) {
+          error(where(param), "node '" + node.name + "': " + param + ": " + problem);
+          references_ok = false;
+          return std::string();
+        }
+        const SourceLocation at = where(param);
+        const std::filesystem::path base =
+            at.line > 0 ? std::filesystem::path(spec_.file).parent_path() : "";
+        return resolve_key_reference(reference, base);
+      };
+      if (const std::string server_text = text("curve_server"); !server_text.empty()) {
+        server = resolve_one("curve_server", server_text);
+      }
+      const std::string client_text = text("curve_client");
+      for (std::size_t start = 0; !client_text.empty() && start <= client_text.size();) {
+        const std::size_t end = std::min(client_text.find(',', start), client_text.size());
+        clients.push_back(resolve_one("curve_client", client_text.substr(start, end - start)));
+        joined += (joined.empty() ? "" : ",") + clients.back();
+        start = end + 1;
+      }
+      if (!references_ok) continue;
+      const bool curve = !server.empty();
+      if (curve != !clients.empty()) {
+        error(spec.where, "node '" + node.name +
+                              "': curve_server and curve_client go together (the server's key "
+                              "and the client keys)");
+        continue;
+      }
+      node.params["curve_server"] = server;
+      node.params["curve_client"] = joined;
+      const Endpoint endpoint = endpoint_of(endpoint_text);
+      if (endpoint.inproc && curve) {
+        error(where("curve_server"),
+              "node '" + node.name + "': curve keys need an ipc:// or tcp:// endpoint");
+      }
+      if (endpoint.beyond_loopback && !spec_.allow_network) {
+        error(where(socket.endpoint_param),
+              "node '" + node.name + "': " + endpoint_text + " reaches beyond this machine (" +
+                  endpoint.host + "); set 'allow_network: true' in the graph to allow it");
+      }
+      if (endpoint.beyond_loopback && !curve) {
+        error(where(socket.endpoint_param),
+              "node '" + node.name + "': " + endpoint_text + " crosses the network (" +
+                  endpoint.host +
+                  ") without keys: set curve_server and curve_client (see docs/security.md, "
+                  "'mocap keys generate')");
+      }
+      if (curve) {
+        check_key_files(where("curve_server"), server, clients, binds && local(node.process),
+                        !binds && local(node.process));
       }
     }
   }

@@ -17,6 +17,7 @@ int reconstruct_command(int argc, char** argv);
 int camera_command(int argc, char** argv);
 int calibrate_command(int argc, char** argv);
 int retarget_command(int argc, char** argv);
+int keys_command(int argc, char** argv);
 int view_command(int argc, char** argv);
 int export_command(int argc, char** argv);
 

@@ -29,6 +29,8 @@ constexpr Command kCommands[] = {
      mocap::cli::calibrate_command},
     {"retarget", "put a BVH motion onto another skeleton (rig given in its rest pose)",
      mocap::cli::retarget_command},
+    {"keys", "CURVE key pairs for graph edges and endpoints that cross the network",
+     mocap::cli::keys_command},
     {"view", "people in 3D in the browser: a poses.jsonl with a timeline, or a live graph",
      mocap::cli::view_command},
     {"export", "BVH motion as a glTF 2.0 binary (GLB): joints, skin, animation",

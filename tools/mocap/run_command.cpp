@@ -77,6 +77,7 @@ int run_command(int argc, char** argv) {
   load_plugins_from_environment();
   GraphSpec spec = load_graph_file(args.positionals()[0]);
   apply_overrides(spec, args.all("set"));
+  spec.local_process = args.get("process");  // key files: only those this process reads
   const ResolvedGraph graph = resolve(std::move(spec));
   for (const std::string& problem : Registry::instance().problems())
     std::cerr << "warning: " << problem << "\n";

@@ -7,6 +7,12 @@ OpenPose *_keypoints.json files; replace read_openpose_folder() with your detect
   python3 tools/remote/send_keypoints.py ../shared/data/eval/openpose_json/json \\
       --endpoint tcp://127.0.0.1:5570
 
+With CURVE security (docs/security.md; required when the node listens beyond loopback), name the
+node's public key and this sender's secret key, files made by `mocap keys generate`:
+
+  python3 tools/remote/send_keypoints.py FOLDER --endpoint tcp://10.0.0.5:5570 \\
+      --server-key keys/solve.pub --client-key keys/detector.key
+
 Needs python3-zmq (Debian) or pyzmq. Exit code 0 when every frame was sent, 1 on a usage or
 sending error.
 """
@@ -76,6 +82,35 @@ def encode_end_of_stream(seq, stream):
     return [header(END_OF_STREAM, seq, 0, 0, stream, 0)]
 
 
+def read_key_file(path, secret):
+    """The Z85 key of a key file written by `mocap keys generate`: its one line that is neither
+    blank nor a '#' comment. A secret key file that group or others may access is refused."""
+    if secret:
+        mode = os.stat(path).st_mode
+        if mode & 0o077:
+            raise ValueError("%s is open to group or others (mode %04o); chmod 600 %s"
+                             % (path, mode & 0o7777, path))
+    with open(path, "rb") as f:
+        data = f.read(4097)
+    if len(data) > 4096:
+        raise ValueError("%s: not a key file (larger than 4 KiB)" % path)
+    lines = [line.strip() for line in data.decode("ascii", "replace").splitlines()]
+    keys = [line for line in lines if line and not line.startswith("#")]
+    if len(keys) != 1 or len(keys[0]) != 40:
+        raise ValueError("%s: not a key file (expected one line of 40 Z85 characters)" % path)
+    return keys[0].encode("ascii")
+
+
+def use_curve(socket, server_key_file, client_key_file):
+    """Makes `socket` a CURVE client of the server whose public key is in server_key_file."""
+    if not zmq.has("curve"):
+        raise ValueError("this libzmq has no CURVE security")
+    secret = read_key_file(client_key_file, secret=True)
+    socket.curve_serverkey = read_key_file(server_key_file, secret=False)
+    socket.curve_secretkey = secret
+    socket.curve_publickey = zmq.curve_public(secret)
+
+
 def frame_number(name):
     numbers = re.findall(r"\d+", name)
     return int(numbers[-1]) if numbers else None
@@ -133,7 +168,16 @@ def main():
     parser.add_argument("--no-end", action="store_true", help="do not send EndOfStream")
     parser.add_argument("--linger-ms", type=int, default=10000,
                         help="how long to wait for unsent messages at the end")
+    parser.add_argument("--server-key", metavar="NAME.pub",
+                        help="CURVE: the node's public key file (with --client-key)")
+    parser.add_argument("--client-key", metavar="NAME.key",
+                        help="CURVE: this sender's secret key file (mode 0600); the node must "
+                        "list its NAME.pub in curve_client")
     args = parser.parse_args()
+    if bool(args.server_key) != bool(args.client_key):
+        parser.error("--server-key and --client-key go together")
+    if args.server_key and args.bind:
+        parser.error("CURVE keys are supported when connecting (without --bind)")
     if args.layout != "auto" and args.layout not in LAYOUTS:
         parser.error("unknown layout %s" % args.layout)
     if not os.path.isdir(args.folder):
@@ -142,6 +186,12 @@ def main():
     context = zmq.Context()
     socket = context.socket(zmq.PUSH)
     socket.setsockopt(zmq.LINGER, args.linger_ms)
+    if args.server_key:
+        try:
+            use_curve(socket, args.server_key, args.client_key)
+        except (OSError, ValueError) as e:
+            print("send_keypoints.py: %s" % e, file=sys.stderr)
+            return 1
     (socket.bind if args.bind else socket.connect)(args.endpoint)
     start_ns, start = time.time_ns(), time.monotonic()
     seq = 0

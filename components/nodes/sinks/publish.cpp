@@ -2,6 +2,7 @@
 // (docs/wire-format.md), for any number of subscribers in any language; sends EndOfStream last.
 // Subscribers that cannot keep up lose messages (PUB never holds the graph back).
 
+#include "graph/keys.hpp"
 #include "graph/registry.hpp"
 #include "graph/transport.hpp"
 
@@ -14,7 +15,10 @@ class Publish : public Node {
     c.doc("Publishes messages on a ZeroMQ PUB socket in the mocap wire format");
     c.input_any("in");
     c.required_param<std::string>(
-        "endpoint", "where to bind, e.g. tcp://127.0.0.1:5560 or ipc:///tmp/mocap-out");
+        "endpoint",
+        "where to bind, e.g. tcp://127.0.0.1:5560 or ipc:///tmp/mocap-out (beyond loopback: "
+        "allow_network and CURVE keys, docs/security.md)");
+    c.network_socket("endpoint");
     c.param<bool>("wait_for_subscriber", false, "hold the first message until a subscriber joined");
     c.param<double>("wait_timeout_ms", 10000.0, "how long to wait for that subscriber", {0, 3.6e6});
     c.param<std::int64_t>("queue", 1000, "messages queued per slow subscriber before dropping",
@@ -24,6 +28,7 @@ class Publish : public Node {
     const bool wait = ctx.param<bool>("wait_for_subscriber");
     SocketOptions options;
     options.high_water_mark = ctx.param<int>("queue");
+    options.curve = node_curve_keys(ctx, true);
     sender_ = std::make_unique<Sender>(
         context_, ctx.param<std::string>("endpoint"),
         wait ? Sender::Pattern::xpublish_bind : Sender::Pattern::publish_bind, options);

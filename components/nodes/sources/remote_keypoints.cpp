@@ -15,6 +15,7 @@
 #include <chrono>
 #include <iostream>
 
+#include "graph/keys.hpp"
 #include "graph/registry.hpp"
 #include "graph/transport.hpp"
 
@@ -27,10 +28,13 @@ class RemoteKeypoints : public Node {
     c.doc("2D keypoints (People2D) from another process over ZeroMQ PULL, in the wire format");
     c.output<People2D>("out", "the keypoints as sent (ids as sent, -1 when untracked)");
     c.required_param<std::string>(
-        "endpoint", "where to bind (or connect), e.g. tcp://*:5570 or ipc:///tmp/mocap-keypoints");
+        "endpoint",
+        "where to bind (or connect), e.g. tcp://127.0.0.1:5570 or ipc:///tmp/mocap-keypoints "
+        "(beyond loopback: allow_network and CURVE keys, docs/security.md)");
     c.param<bool>("bind", true,
                   "bind the endpoint (senders connect, any number); false: connect to a sender "
                   "that binds");
+    c.network_socket("endpoint", "bind");
     c.param<double>("timeout_ms", 0.0,
                     "end of stream after this long without a message (0: wait until EndOfStream "
                     "or the graph stops)",
@@ -46,6 +50,7 @@ class RemoteKeypoints : public Node {
     // A People2D at the format's limits (4096 people x 256 joints) is 12.6 MB; anything larger
     // is refused by ZeroMQ before it is allocated (the sender's connection is dropped).
     options.max_message_bytes = std::int64_t{16} << 20;
+    options.curve = node_curve_keys(ctx, ctx.param<bool>("bind"));
     endpoint_ = ctx.param<std::string>("endpoint");
     receiver_ = std::make_unique<Receiver>(
         context_, endpoint_, options,
