@@ -42,12 +42,21 @@ BvhStreamWriter::BvhStreamWriter(std::string path, Skeleton skeleton, double fra
     throw std::invalid_argument("BvhStreamWriter: the skeleton has no channels (" + path_ + ")");
   if (!(frame_time > 0.0) || !std::isfinite(frame_time))
     throw std::invalid_argument("BvhStreamWriter: frame time must be positive (" + path_ + ")");
-  fd_ = ::open(path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  // The file appears with its whole header or not at all: the header is written to PATH.part,
+  // which is then renamed to PATH (a kill in between leaves no PATH, or the old one). A special
+  // file (/dev/null, /dev/full) is written in place.
+  struct stat existing {};
+  const bool special = ::stat(path_.c_str(), &existing) == 0 && !S_ISREG(existing.st_mode);
+  const std::string part = special ? path_ : path_ + ".part";
+  fd_ = ::open(part.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd_ < 0) throw InputError(path_, error_text("cannot create the BVH file"));
   try {
     write_header(frame_time);
+    if (!special && ::rename(part.c_str(), path_.c_str()) != 0)
+      throw InputError(path_, error_text("cannot create the BVH file"));
   } catch (...) {
     release();
+    if (!special) ::unlink(part.c_str());
     throw;
   }
 }

@@ -2,7 +2,8 @@
 // Writes a BVH file one frame at a time, so that the file on disk is a valid BVH after every
 // frame, also when the process is killed (SIGKILL, a crash) at any moment:
 //
-// - the hierarchy and "Frames: 0000000000" (a fixed-width count) are written first;
+// - the hierarchy and "Frames: 0000000000" (a fixed-width count) are written first, to PATH.part,
+//   which is then renamed to PATH: the file never exists without its whole header;
 // - each frame is one write() of one line, then the count is rewritten in place (pwrite);
 // - a line never crosses a 4 KiB page boundary (spaces at the start of a line pad it to the next
 //   page when it would), and neither does the count, because the kernel can stop a write killed
@@ -27,7 +28,7 @@ class BvhStreamWriter {
   // The most frames a file may hold: the reader's limit.
   static constexpr std::int64_t kMaxFrames = 100'000'000;
 
-  // Creates (or truncates) `path` and writes the hierarchy and a frame count of 0. Throws
+  // Creates (or replaces) `path` with the hierarchy and a frame count of 0. Throws
   // mocap::InputError naming the file when it cannot be created or written.
   BvhStreamWriter(std::string path, Skeleton skeleton, double frame_time);
   BvhStreamWriter(BvhStreamWriter&& other) noexcept;

@@ -158,6 +158,14 @@ TEST(BvhStreamWriter, FileOfAProcessKilledMidWriteReadsBack) {
       }
       _exit(2);
     }
+    // The first rounds kill at any moment from the start, also before the file exists; the later
+    // ones count from the file's appearance, so that a slow start (a loaded machine, a sanitizer
+    // build) still leaves time for frames.
+    if (round > 4) {
+      const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+      while (!std::filesystem::exists(path) && std::chrono::steady_clock::now() < give_up)
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
     std::this_thread::sleep_for(std::chrono::milliseconds(15 + 9 * round));
     ASSERT_EQ(kill(child, SIGKILL), 0);
     int status = 0;
