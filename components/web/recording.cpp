@@ -32,6 +32,22 @@ std::array<glm::vec3, kBodyJoints> joints_of(const Json& joints, const std::stri
   return out;
 }
 
+// sink.jsonl's flat [x, y, confidence] x 15; a missing keypoint stays at confidence 0.
+std::array<Keypoint2D, kBodyJoints> keypoints_of(const Json& flat, const std::string& what) {
+  if (!flat.is_array() || flat.size() != 3 * kBodyJoints)
+    throw std::invalid_argument(what + " keypoints are not 15 x [x, y, confidence]");
+  std::array<Keypoint2D, kBodyJoints> out{};
+  for (std::size_t j = 0; j < out.size(); ++j) {
+    for (std::size_t c = 0; c < 3; ++c)
+      if (!flat[3 * j + c].is_number())
+        throw std::invalid_argument(what + " keypoints hold something not a number");
+    out[j] = {flat[3 * j].get<float>(), flat[3 * j + 1].get<float>(), flat[3 * j + 2].get<float>()};
+    if (!(out[j].confidence > 0) || !std::isfinite(out[j].x) || !std::isfinite(out[j].y))
+      out[j] = {};
+  }
+  return out;
+}
+
 People3D frame_of(const Json& line, std::int64_t number) {
   if (!line.is_object()) throw std::invalid_argument("not a JSON object");
   People3D frame;
@@ -52,6 +68,8 @@ People3D frame_of(const Json& line, std::int64_t number) {
       person.placed = true;
       person.root.translation = placed[index(Joint::root)] - person.positions[index(Joint::root)];
     }
+    if (const auto kp = p.find("keypoints"); kp != p.end())
+      person.keypoints = keypoints_of(*kp, what);
     frame.people.push_back(person);
   }
   if (const auto ground = line.find("ground"); ground != line.end()) {

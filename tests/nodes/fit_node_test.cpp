@@ -56,6 +56,7 @@ struct Placed {
   std::map<int, std::vector<glm::dvec3>> roots;                              // per person
   std::map<int, std::vector<std::array<double, kBodyJoints>>> bone_lengths;  // per person
   std::size_t lines = 0, people = 0, placed = 0;
+  std::size_t with_keypoints = 0;  // people whose 2D input was written (15 x [x, y, confidence])
   std::vector<int> people_in_frame;
 };
 
@@ -67,6 +68,9 @@ Placed read_placed(const std::string& jsonl) {
     out.people_in_frame.push_back(static_cast<int>(frame.at("people").size()));
     for (const auto& person : frame.at("people")) {
       ++out.people;
+      if (person.contains("keypoints") && person.at("keypoints").size() == 3 * kBodyJoints &&
+          person.at("keypoints")[3 * index(Joint::root) + 2].get<double>() > 0)
+        ++out.with_keypoints;
       if (!person.contains("joints_abs")) continue;
       ++out.placed;
       const int id = person.at("id").get<int>();
@@ -98,6 +102,7 @@ void expect_placed_at_their_depth(const Placed& placed) {
   EXPECT_EQ(placed.lines, 16u);  // one line per input frame
   EXPECT_EQ(placed.people, 31u);
   EXPECT_EQ(placed.placed, 31u);
+  EXPECT_EQ(placed.with_keypoints, 31u);    // the 2D input is kept beside the 3D output
   EXPECT_EQ(placed.people_in_frame[7], 1);  // person 2 stays absent where it was absent
   for (const auto& [id, roots] : placed.roots) {
     const double x = id == 1 ? 0.0 : 1.2;
@@ -115,10 +120,10 @@ TEST(FitNode, LivePlacesPeopleAtTheDepthTheirProjectionShowsWithConstantBones) {
   MOCAP_REQUIRE_SMALL_DATABASE(db);
   test::TempDir dir;
   const std::string jsonl = dir.file("poses.jsonl");
-  const auto result =
-      run_graph(fit_graph(db, walking_script(), jsonl,
-                          "mode: live, lag: 3, contact: false, image_width: 640, image_height: 480, hfov_deg: " +
-                              std::to_string(kHfovDeg)));
+  const auto result = run_graph(fit_graph(
+      db, walking_script(), jsonl,
+      "mode: live, lag: 3, contact: false, image_width: 640, image_height: 480, hfov_deg: " +
+          std::to_string(kHfovDeg)));
   ASSERT_TRUE(result.ok) << result.error;
   EXPECT_EQ(stats_of(result, "fit").out, 16u);
   expect_placed_at_their_depth(read_placed(jsonl));
@@ -128,9 +133,10 @@ TEST(FitNode, FullSequencePlacesPeopleAtTheirDepthWithConstantBones) {
   MOCAP_REQUIRE_SMALL_DATABASE(db);
   test::TempDir dir;
   const std::string jsonl = dir.file("poses.jsonl");
-  const auto result = run_graph(fit_graph(
-      db, walking_script(), jsonl,
-      "mode: full, contact: false, image_width: 640, image_height: 480, hfov_deg: " + std::to_string(kHfovDeg)));
+  const auto result = run_graph(
+      fit_graph(db, walking_script(), jsonl,
+                "mode: full, contact: false, image_width: 640, image_height: 480, hfov_deg: " +
+                    std::to_string(kHfovDeg)));
   ASSERT_TRUE(result.ok) << result.error;
   expect_placed_at_their_depth(read_placed(jsonl));
 }

@@ -120,6 +120,10 @@ TEST(Recording, ReadsJointsPlacementFloorAndTimes) {
     line["people"] = Json::array({{{"id", 4}, {"joints", joints}}});
     if (f == 2) {
       line["people"][0]["joints_abs"] = absolute;
+      Json keypoints = Json::array();
+      for (int j = 0; j < kBodyJoints; ++j)
+        keypoints.insert(keypoints.end(), {100.5 + j, 200.0, j == 3 ? 0.0 : 0.9});
+      line["people"][0]["keypoints"] = keypoints;
       line["ground"] = {{"normal", {0.0, -1.0, 0.0}}, {"offset", 1.2}};
     }
     text += line.dump() + "\n\n";
@@ -140,6 +144,14 @@ TEST(Recording, ReadsJointsPlacementFloorAndTimes) {
   EXPECT_NEAR(p.positions[index(Joint::neck)].y, -0.1f, 1e-6);
   EXPECT_TRUE(r.frames[2].has_ground);
   EXPECT_NEAR(r.frames[2].ground.offset, 1.2f, 1e-6);
+  // The 2D input written by sink.jsonl comes back for the viewer's 2D panel; 0 confidence =
+  // missing.
+  EXPECT_EQ(r.frames[0].people[0].keypoints[0].confidence, 0.0f);
+  EXPECT_NEAR(p.keypoints[2].x, 102.5f, 1e-4);
+  EXPECT_NEAR(p.keypoints[2].y, 200.0f, 1e-4);
+  EXPECT_NEAR(p.keypoints[2].confidence, 0.9f, 1e-6);
+  EXPECT_EQ(p.keypoints[3].confidence, 0.0f);
+  EXPECT_EQ(p.keypoints[3].x, 0.0f);
 }
 
 TEST(Recording, WithoutTimesFramesAreSpacedByTheFrameRate) {
@@ -170,6 +182,16 @@ TEST(Recording, GarbageIsAnErrorNamingTheFileAndLine) {
                 .find("has no joint 'neck'"),
             std::string::npos);
   EXPECT_NE(message("{\"people\": 5}").find("bad.jsonl:1:"), std::string::npos);
+  std::string joints;
+  for (int j = 0; j < kBodyJoints; ++j)
+    joints += std::string(j ? ", " : "") + "\"" + std::string(kJointNames[j]) + "\": [0, 0, 0]";
+  const std::string person = "{\"people\": [{\"id\": 1, \"joints\": {" + joints + "}, ";
+  EXPECT_NE(message(person + "\"keypoints\": [1, 2, 3]}]}").find("not 15 x [x, y, confidence]"),
+            std::string::npos);
+  EXPECT_NE(
+      message(person + "\"keypoints\": " + Json(std::vector<std::string>(45, "a")).dump() + "}]}")
+          .find("something not a number"),
+      std::string::npos);
   EXPECT_NE(message("[1, 2]").find("bad.jsonl:1:"), std::string::npos);
   EXPECT_NE(message("{\"people\": [], \"ground\": {\"normal\": [0, 0, 0], \"offset\": 1}}")
                 .find("bad.jsonl:1:"),

@@ -1,13 +1,19 @@
 // sink.jsonl: one JSON line per input frame, in input order:
 //   {"frame": 0, "time": 0.0, "people": [{"id": 1, "joints": {"head": [x, y, z], ...},
-//    "joints_abs": {...}}], "ground": {"normal": [x, y, z], "offset": d}}
+//    "joints_abs": {...}, "keypoints": [x, y, c, ...]}], "ground": {"normal": [x, y, z], "offset":
+//    d}}
 // with the 15 body joint names, metres, camera coordinates (x right, y down, z forward).
 // `joints` are root-relative; `joints_abs` (absolute camera-frame positions) appear for people
-// whose root translation is estimated (recon.fit), `ground` once the floor is known (points p
+// whose root translation is estimated (recon.fit), `keypoints` (the 15 body joints' 2D input, image
+// pixels as detected and confidence, 0 0 0 where missing) for people reconstructed from a 2D
+// detection, so that a recording can be replayed beside its input (mocap view), `ground` once the
+// floor is known (points p
 // with normal . p + offset = 0, normal up). Each line is flushed as it is written, so the file
 // holds every finished frame even if the run is killed.
 
+#include <algorithm>
 #include <cerrno>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <memory>
@@ -39,6 +45,7 @@ class JsonLinesSink : public Node {
     for (const Person3D& p : in.people) {
       nlohmann::ordered_json person = {{"id", p.id}, {"joints", joints_of(p, glm::vec3(0.0f))}};
       if (p.placed) person["joints_abs"] = joints_of(p, p.root.translation);
+      if (has_keypoints(p)) person["keypoints"] = keypoints_of(p);
       people.push_back(std::move(person));
     }
     nlohmann::ordered_json line = {{"frame", in.header.frame},
@@ -65,6 +72,21 @@ class JsonLinesSink : public Node {
       joints[std::string(kJointNames[j])] = {round_mm(v.x), round_mm(v.y), round_mm(v.z)};
     }
     return joints;
+  }
+  static bool has_keypoints(const Person3D& p) {
+    return std::any_of(p.keypoints.begin(), p.keypoints.end(),
+                       [](const Keypoint2D& k) { return k.confidence > 0; });
+  }
+  // Flat [x, y, confidence] per joint, a tenth of a pixel; a missing keypoint is 0 0 0.
+  static nlohmann::ordered_json keypoints_of(const Person3D& p) {
+    nlohmann::ordered_json out = nlohmann::ordered_json::array();
+    for (const Keypoint2D& k : p.keypoints) {
+      const bool ok = k.confidence > 0 && std::isfinite(k.x) && std::isfinite(k.y);
+      out.push_back(ok ? std::round(static_cast<double>(k.x) * 10.0) / 10.0 : 0.0);
+      out.push_back(ok ? std::round(static_cast<double>(k.y) * 10.0) / 10.0 : 0.0);
+      out.push_back(ok ? std::round(static_cast<double>(k.confidence) * 100.0) / 100.0 : 0.0);
+    }
+    return out;
   }
   // Millimetre precision keeps the file small and the numbers readable.
   static double round_mm(float v) { return std::round(static_cast<double>(v) * 1000.0) / 1000.0; }
