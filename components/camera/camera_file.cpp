@@ -82,15 +82,22 @@ void open_text(cv::FileStorage& fs, std::string_view text, const std::string& na
   // OpenCV reads C strings: text with a NUL byte would be cut there, so it is refused whole.
   if (text.find('\0') != std::string_view::npos)
     throw InputError(name, "not a text file (NUL byte)");
-  // A camera file is one YAML document. OpenCV 4.6's YAML parser loops forever on some texts
-  // with a second document start (e.g. "---YAML:1.0" then "---" and a list), and looks keys up
-  // in another document than root(): more than one "---" line is refused before it parses.
+  // A camera file is one YAML document whose start line is "---" alone, as OpenCV writes it.
+  // OpenCV 4.6's YAML parser loops forever on some other starts ("----a" or "---YAML:1.0" and
+  // "---", each followed by a list) and looks keys up outside root() when there are two
+  // documents, so both are refused before it parses.
   int document_starts = 0;
   for (std::size_t at = 0; at < text.size();) {
-    if (text.compare(at, 3, "---") == 0 && ++document_starts > 1)
-      throw InputError(name, "more than one YAML document (a second '---' line)");
-    const std::size_t end = text.find('\n', at);
-    at = end == std::string_view::npos ? text.size() : end + 1;
+    const std::size_t end = std::min(text.find('\n', at), text.size());
+    if (text.compare(at, 3, "---") == 0) {
+      const std::string_view rest = text.substr(at + 3, end - at - 3);
+      const std::size_t content = rest.find_first_not_of(" \t\r");
+      if (content != std::string_view::npos && rest[content] != '#')
+        throw InputError(name, "a '---' line with more on it (only '---' starts the document)");
+      if (++document_starts > 1)
+        throw InputError(name, "more than one YAML document (a second '---' line)");
+    }
+    at = end + 1;
   }
   try {
     if (!fs.open(std::string(text), cv::FileStorage::READ | cv::FileStorage::MEMORY))
