@@ -1,6 +1,6 @@
 // mocap-bench-graph: throughput and latency of one edge per transport (in-process queue, and
-// ZeroMQ over inproc://, ipc://, tcp://127.0.0.1) for small messages (one person, COCO-17) and
-// 1920x1080 RGB frames. Prints a Markdown table.
+// ZeroMQ over inproc://, ipc://, tcp://127.0.0.1 plain and with CURVE) for small messages (one
+// person, COCO-17) and 1920x1080 RGB frames. Prints a Markdown table.
 //
 // Throughput: a producer thread sends as fast as a blocking(16) edge lets it. Latency: one
 // message at a time (the next leaves when the previous arrived), send to receive, one way.
@@ -160,13 +160,21 @@ int main(int argc, char** argv) {
       print_row("in-process", payload, measure(edge, payload, count, latency_count));
     }
     int port = 5790;
-    for (const std::string kind : {"inproc", "ipc", "tcp"}) {
+    for (const std::string kind : {"inproc", "ipc", "tcp", "tcp+curve"}) {
       const std::string endpoint = kind == "inproc" ? "inproc://bench"
                                    : kind == "ipc"  ? "ipc://" + ipc_dir + "/edge"
                                                     : "tcp://127.0.0.1:" + std::to_string(port++);
+      // tcp+curve: the same edge encrypted and authenticated with CURVE (docs/security.md).
+      SocketOptions server, client;
+      if (kind == "tcp+curve") {
+        const CurveKeyPair server_keys = generate_curve_key_pair();
+        const CurveKeyPair client_keys = generate_curve_key_pair();
+        server.curve = {server_keys.secret_key, {}, {client_keys.public_key}};
+        client.curve = {client_keys.secret_key, server_keys.public_key, {}};
+      }
       TransportContext context;
-      Receiver receiver(context, endpoint);
-      Sender sender(context, endpoint, Sender::Pattern::edge);
+      Receiver receiver(context, endpoint, server);
+      Sender sender(context, endpoint, Sender::Pattern::edge, client);
       Edge edge = zeromq_edge(sender, receiver);
       print_row(kind, payload, measure(edge, payload, count, latency_count));
     }
