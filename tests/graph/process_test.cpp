@@ -235,7 +235,9 @@ TEST(Process, GarbageSentToARunningGraphIsRejectedWithAMessage) {
   // Speak ZeroMQ to its people edge, but not the wire format.
   void* context = zmq_ctx_new();
   void* raw = zmq_socket(context, ZMQ_DEALER);
-  const int linger = 2000;
+  // Sent before `solve` may have bound (a slow start: a loaded machine, a sanitizer build); the
+  // linger keeps them queued until it has, for at most 20 s.
+  const int linger = 20000;
   zmq_setsockopt(raw, ZMQ_LINGER, &linger, sizeof linger);
   ASSERT_EQ(zmq_connect(raw, ("ipc://" + dir.file("people")).c_str()), 0);
   for (const char* junk :
