@@ -68,6 +68,12 @@ class Contract {
   // resolves the references, which the node hands to load_curve_keys (graph/keys.hpp).
   void network_socket(std::string endpoint_param, std::string bind_param = {});
 
+  // The node serves HTTP (a page, WebSocket streams) with no authentication on the address in
+  // parameter `host_param`: validation refuses anything but loopback unless the graph says
+  // `allow_network: true`.
+  void serves_http(std::string host_param) { http_host_param_ = std::move(host_param); }
+  const std::string& http_host_param() const { return http_host_param_; }
+
   // Sources only: instead of ending by itself, the node runs until every node that does not
   // depend on it has finished (a statistics reporter, a heartbeat).
   void runs_until_graph_ends() { auxiliary_ = true; }
@@ -110,6 +116,7 @@ class Contract {
   std::vector<ParamSpec> params_;
   bool auxiliary_ = false;
   std::optional<NetworkSocket> network_;
+  std::string http_host_param_;
 };
 
 }  // namespace mocap::graph

@@ -36,6 +36,7 @@ class Checker {
     check_placement();
     check_transports();
     check_network_nodes();
+    check_http_servers();
     if (!errors_.empty()) {
       std::string message;
       for (const auto& e : errors_) message += (message.empty() ? "" : "\n") + e;
@@ -452,6 +453,26 @@ class Checker {
                         !binds && local(node.process));
       }
     }
+  }
+
+  // Nodes that serve HTTP without authentication (Contract::serves_http): loopback unless allowed.
+  void check_http_servers() {
+    for (const ResolvedNode& node : nodes_) {
+      if (!node.type || node.type->contract.http_host_param().empty()) continue;
+      const std::string& param = node.type->contract.http_host_param();
+      const auto it = node.params.find(param);
+      const auto* host = it == node.params.end() ? nullptr : std::get_if<std::string>(&it->second);
+      if (!host || is_loopback_host(*host) || spec_.allow_network) continue;
+      const NodeSpec& spec = *spec_.find_node(node.name);
+      const auto at = spec.params.find(param);
+      error(at == spec.params.end() ? spec.where : at->second.where,
+            "node '" + node.name + "': " + param + " " + *host +
+                " serves the page beyond this machine, to anyone, without authentication; set "
+                "'allow_network: true' in the graph to allow it");
+    }
+  }
+  static bool is_loopback_host(const std::string& host) {
+    return host == "localhost" || host == "::1" || host == "[::1]" || host.rfind("127.", 0) == 0;
   }
 
   GraphSpec& spec_;

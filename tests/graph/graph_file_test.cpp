@@ -179,6 +179,16 @@ TEST(GraphFile, EdgeProblems) {
       "edges:\n  - [a.out, s.in, { transport: \"tcp://0.0.0.0:5555\" }]\n");
   EXPECT_NE(message.find("g.yaml:5:"), std::string::npos) << message;
   EXPECT_NE(message.find("allow_network: true"), std::string::npos) << message;
+  // The viewer's page has no authentication: beyond loopback only when the graph allows it.
+  message = problems("nodes:\n  v: { type: sink.web, params: { host: 0.0.0.0 } }\n");
+  EXPECT_NE(message.find("g.yaml:2: node 'v': host 0.0.0.0 serves the page beyond this machine"),
+            std::string::npos)
+      << message;
+  message =
+      problems("allow_network: true\nnodes:\n  v: { type: sink.web, params: { host: 0.0.0.0 } }\n");
+  EXPECT_EQ(message.find("without authentication"), std::string::npos) << message;
+  message = problems("nodes:\n  v: { type: sink.web, params: { host: 127.0.0.1 } }\n");
+  EXPECT_EQ(message.find("without authentication"), std::string::npos) << message;
   message = problems("nodes:\n  a: { type: test.counter }\nedges:\n  - [a, b]\n");
   EXPECT_NE(message.find("g.yaml:4: edge end 'a' must be written node.port"), std::string::npos)
       << message;

@@ -108,6 +108,10 @@ int view_recording(const Args& args) {
   return 0;
 }
 
+bool is_loopback_host(const std::string& host) {
+  return host == "localhost" || host == "::1" || host == "[::1]" || host.rfind("127.", 0) == 0;
+}
+
 // The People3D output of the graph's last stage that makes one (in topological order).
 std::optional<graph::PortRef> last_people3d_output(const graph::ResolvedGraph& graph) {
   std::optional<graph::PortRef> found;
@@ -124,6 +128,7 @@ int view_graph(const Args& args) {
   graph::load_plugins_from_environment();
   graph::GraphSpec spec = graph::load_graph_file(args.get("graph"));
   apply_overrides(spec, args.all("set"));
+  if (args.has("allow-network")) spec.allow_network = true;
   const graph::ResolvedGraph plain = graph::resolve(spec);
   const graph::SourceLocation here{"mocap view", 0};
   bool has_viewer = false;
@@ -180,7 +185,10 @@ int view_command(int argc, char** argv) {
       .option("graph", "GRAPH", "run this graph file with a viewer attached")
       .option("set", "NODE.PARAM=VALUE", "override a node parameter (with --graph)", std::nullopt,
               true)
-      .option("host", "ADDRESS", "address to serve on (0.0.0.0: every interface)", "127.0.0.1")
+      .option("host", "ADDRESS",
+              "address to serve on (0.0.0.0: every interface, with --allow-network)", "127.0.0.1")
+      .flag("allow-network",
+            "let --host be an address other machines reach (the page has no authentication)")
       .option("port", "P", "TCP port; 0 picks a free one (graph: 8080 unless given)", "8080")
       .option("queue", "N", "frames waiting per browser before the oldest is dropped", "4")
       .option("fps", "F", "frame rate of a recording without usable times", "30")
@@ -193,6 +201,12 @@ int view_command(int argc, char** argv) {
   const bool graph = args.has("graph");
   if (graph == !args.positionals().empty()) {
     std::cerr << "mocap view: give either POSES.jsonl or --graph GRAPH\n\n" << args.help();
+    return 2;
+  }
+  if (!graph && !is_loopback_host(args.get("host")) && !args.has("allow-network")) {
+    std::cerr << "mocap view: --host " << args.get("host")
+              << " serves the page beyond this machine, to anyone, without authentication; add "
+                 "--allow-network to allow it\n";
     return 2;
   }
   return graph ? view_graph(args) : view_recording(args);

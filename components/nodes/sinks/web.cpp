@@ -21,7 +21,9 @@ class WebSink : public Node {
     c.doc("Live 3D viewer in the browser: serves a page and streams every frame over a WebSocket");
     c.input<People3D>("in");
     c.param<std::string>("host", "127.0.0.1",
-                         "address to serve on (loopback; 0.0.0.0 for every interface)");
+                         "address to serve on (loopback; 0.0.0.0 for every interface, which "
+                         "needs allow_network: true)");
+    c.serves_http("host");
     c.param<int>("port", 8080, "TCP port (0: a free one; the URL is printed)", {0, 65535});
     c.param<int>("queue", 4, "frames waiting per browser before the oldest is dropped", {1, 1000});
     c.param<std::string>("title", "mocap", "title shown by the page");
