@@ -43,9 +43,11 @@ bool python_has_zmq() {
 // A raw ZeroMQ socket for the test's own side.
 class Socket {
  public:
-  Socket(int type, const std::string& endpoint) {
+  // What is sent stays queued up to `linger_ms` for a peer that is slow to bind (a loaded
+  // machine, a sanitizer build: 2 s lost the garbage under ASan).
+  Socket(int type, const std::string& endpoint, int linger_ms = 20000) {
     socket_ = zmq_socket(context_, type);
-    const int linger = 2000, timeout = 30000;
+    const int linger = linger_ms, timeout = 30000;
     zmq_setsockopt(socket_, ZMQ_LINGER, &linger, sizeof linger);
     zmq_setsockopt(socket_, ZMQ_RCVTIMEO, &timeout, sizeof timeout);
     if (type == ZMQ_SUB) zmq_setsockopt(socket_, ZMQ_SUBSCRIBE, "", 0);
@@ -173,7 +175,7 @@ TEST_F(RemoteKeypointsTest, KeypointsFromPythonArriveAsSentAndGarbageIsCounted) 
   {
     // Beyond ZeroMQ's 16 MiB limit of the node: that sender is disconnected (not counted), and
     // the node goes on.
-    Socket huge(ZMQ_PUSH, in);
+    Socket huge(ZMQ_PUSH, in, 2000);
     huge.send({std::string(17u << 20, 'x')});
   }
   EXPECT_TRUE(run.wait_for_log("rejected message 1: .* from 127\\.0\\.0\\.1 on " + in, 1s))
