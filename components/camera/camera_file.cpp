@@ -89,6 +89,13 @@ void open_text(cv::FileStorage& fs, std::string_view text, const std::string& na
   int document_starts = 0;
   for (std::size_t at = 0; at < text.size();) {
     const std::size_t end = std::min(text.find('\n', at), text.size());
+    const std::string_view line = text.substr(at, end - at);
+    // Directives ("%YAML:1.0") only as the first line, document ends ("...") not at all: OpenCV
+    // also loops forever on texts that mix them with document starts.
+    if (line.starts_with("%") && (at != 0 || line.find("---") != std::string_view::npos))
+      throw InputError(name, "a YAML directive ('%') after the first line or with '---' on it");
+    if (line.starts_with("..."))
+      throw InputError(name, "a YAML document end ('...'): a camera file is one document");
     if (text.compare(at, 3, "---") == 0) {
       const std::string_view rest = text.substr(at + 3, end - at - 3);
       const std::size_t content = rest.find_first_not_of(" \t\r");
