@@ -274,6 +274,7 @@ class NodeRunner final : public Context {
   Clock::duration slept_{};
 
   std::atomic<std::uint64_t> in_{0}, out_{0}, own_drops_{0};
+  std::uint64_t abandoned_at_stop_ = 0;  // data left in the inbox after the drain deadline
   std::atomic<int> state_{waiting};
   std::atomic<bool> thread_finished_{false};
   LatencyWindow latency_;
@@ -329,6 +330,13 @@ void NodeRunner::run_consumer() {
       continue;
     }
     ++in_;
+    // A stop bounds the drain: once its deadline has passed, what is still queued is counted
+    // (a drop, and a log line at the end) instead of processed, so the graph exits in time.
+    if (runtime_.drain_expired()) {
+      ++abandoned_at_stop_;
+      ++own_drops_;
+      continue;
+    }
     current_port_ = delivery->port;
     current_ = &delivery->packet;
     timed_process();
@@ -352,6 +360,11 @@ void NodeRunner::run() {
   }
   current_ = nullptr;
   inbox_.close();
+  if (abandoned_at_stop_ > 0) {
+    runtime_.log("node '" + node_.name + "': " + std::to_string(abandoned_at_stop_) +
+                 " queued message(s) not processed: the stop's drain deadline (" +
+                 std::to_string(runtime_.options.drain_timeout.count()) + " ms) passed");
+  }
   if (opened) {
     try {
       instance_->close(*this);

@@ -17,9 +17,10 @@ namespace mocap::graph {
 struct RunOptions {
   std::string process;          // run only this process group; empty: every node
   bool single_process = false;  // ignore transports: every edge in-process
-  // After a stop request, how long an edge from another process waits for its end of stream, and
-  // how long a send waits for a full peer, before giving up.
-  std::chrono::milliseconds drain_timeout{3000};
+  // After a stop request, how long the graph drains: queued messages are processed, an edge from
+  // another process waits for its end of stream and a send for a full peer, until this passes;
+  // then what is still queued is counted and logged, not processed (so SIGTERM exits within 2 s).
+  std::chrono::milliseconds drain_timeout{1500};
   std::function<void(const std::string&)> log;  // warnings; stderr when empty
 };
 

@@ -143,6 +143,38 @@ TEST(Process, SigtermMidRunFlushesTheSinksAndExitsZero) {
   expect_contiguous_from_zero(lines);
 }
 
+TEST(Process, SigtermWithAFullQueueBehindASlowNodeExitsWithinTheDrainDeadline) {
+  TempDir dir;
+  const std::string graph = dir.file("g.yaml");
+  // 60 messages queued at 200 ms each would take 12 s to drain: the deadline (1.5 s) cuts it.
+  testing::write_file(
+      graph,
+      "nodes:\n  src: { type: test.counter, params: { count: 0, interval_ms: 1 } }\n"
+      "  slow: { type: test.delay, params: { delay_ms: 200 } }\n"
+      "  sink: { type: test.collect, params: { path: " +
+          dir.file("out.txt") +
+          " } }\n"
+          "edges:\n  - [src.out, slow.in, { policy: blocking(60) }]\n  - [slow.out, sink.in]\n");
+  Mocap run(dir, "run", {"run", graph});
+  ASSERT_TRUE(run.wait_until_blocking(SIGTERM, 30s)) << run.err();
+  std::this_thread::sleep_for(1s);  // the queue fills
+  const auto stop = std::chrono::steady_clock::now();
+  kill(run.pid(), SIGTERM);
+  ASSERT_EQ(run.wait(30s), 0) << run.err();
+  const auto took = std::chrono::steady_clock::now() - stop;
+#if defined(__SANITIZE_ADDRESS__)
+  EXPECT_LT(took, 6s) << run.err();
+#else
+  EXPECT_LT(took, 2s) << run.err();
+#endif
+  EXPECT_NE(run.err().find("queued message(s) not processed: the stop's drain deadline (1500 ms)"),
+            std::string::npos)
+      << run.err();
+  const auto lines = testing::read_lines(dir.file("out.txt"));
+  EXPECT_GE(lines.size(), 4u);  // what was processed before the deadline reached the sink
+  expect_contiguous_from_zero(lines);
+}
+
 TEST(Process, NodeFailureExitsNonZeroNamingTheNode) {
   TempDir dir;
   const std::string graph = dir.file("g.yaml");
