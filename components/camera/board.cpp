@@ -199,7 +199,9 @@ std::string for_each_image(const std::vector<std::string>& files, const ViewSink
 void for_each_video_frame(const std::string& video, int step, const ViewSink& add) {
   cv::VideoCapture capture;
   try {
-    capture.open(video);
+    // A calibration video is a file: FFmpeg reads it (CAP_ANY would go on to GStreamer for a file
+    // FFmpeg refuses, which leaks and prints a stack of errors).
+    capture.open(video, cv::CAP_FFMPEG);
   } catch (const cv::Exception&) {
   }
   if (!capture.isOpened()) throw InputError(video, "cannot open the video");

@@ -57,6 +57,7 @@ struct Runtime::Impl {
     {
       std::lock_guard lock(mutex);
       if (error.empty()) error = message;
+      if (!stopping) stopped_by_failure = true;
     }
     request_stop();
   }
@@ -68,6 +69,12 @@ struct Runtime::Impl {
   bool drain_expired() const {
     std::lock_guard lock(mutex);
     return stopping && Clock::now() - stop_time > options.drain_timeout;
+  }
+  // A stop asked for (a signal) whose drain deadline has passed: queued messages are left then.
+  // A node's failure drains everything already queued (what came before the failure is kept).
+  bool abandon_queued() const {
+    std::lock_guard lock(mutex);
+    return stopping && !stopped_by_failure && Clock::now() - stop_time > options.drain_timeout;
   }
   bool auxiliary_released() const {
     std::lock_guard lock(mutex);
@@ -110,6 +117,7 @@ struct Runtime::Impl {
   mutable std::mutex mutex;
   std::condition_variable wake;
   bool stopping = false;
+  bool stopped_by_failure = false;  // the stop came from a failing node, not a request
   Clock::time_point stop_time;
   int aux_blockers = 0;
   bool aux_released = false;
@@ -332,7 +340,7 @@ void NodeRunner::run_consumer() {
     ++in_;
     // A stop bounds the drain: once its deadline has passed, what is still queued is counted
     // (a drop, and a log line at the end) instead of processed, so the graph exits in time.
-    if (runtime_.drain_expired()) {
+    if (runtime_.abandon_queued()) {
       ++abandoned_at_stop_;
       ++own_drops_;
       continue;

@@ -3,6 +3,7 @@
 // floor with the hips above it, at the rate the frames come in; all_people uses successive ports.
 
 #include <lo/lo.h>
+#include <cstring>
 
 #include <chrono>
 #include <cmath>
@@ -97,8 +98,17 @@ class OscReceiver {
     m.types = types;
     for (int i = 0; i < argc; ++i) {
       if (types[i] == 's') m.name = &argv[i]->s;
-      if (types[i] == 'f') m.values.push_back(argv[i]->f);
-      if (types[i] == 'i') m.values.push_back(static_cast<float>(argv[i]->i));
+      // liblo's arguments point into the packet, not always aligned for lo_arg: copy the bytes.
+      if (types[i] == 'f') {
+        float f = 0;
+        std::memcpy(&f, argv[i], sizeof f);
+        m.values.push_back(f);
+      }
+      if (types[i] == 'i') {
+        std::int32_t v = 0;
+        std::memcpy(&v, argv[i], sizeof v);
+        m.values.push_back(static_cast<float>(v));
+      }
     }
     std::lock_guard lock(r->mutex_);
     m.bundle = r->in_bundle_ ? static_cast<int>(r->bundle_times_.size()) - 1 : -1;
