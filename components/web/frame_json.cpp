@@ -22,14 +22,15 @@ Json rounded(double v, double scale) {
 
 }  // namespace
 
-GroundPlane assumed_ground() { return GroundPlane{{0.0f, -1.0f, 0.0f}, 1.5f}; }
+GroundPlane assumed_ground() { return GroundPlane{{0.0, -1.0, 0.0}, 1.5}; }
 
 glm::vec3 display_root(const GroundPlane& ground, std::size_t slot, std::size_t count) {
   const float x = (static_cast<float>(slot) - 0.5f * static_cast<float>(count - 1)) * 0.8f;
   const glm::vec3 ahead(x, 0.0f, 3.0f);
+  const glm::vec3 normal(ground.normal);
   const glm::vec3 on_floor =
-      ahead - (glm::dot(ground.normal, ahead) + ground.offset) * ground.normal;
-  return on_floor + 0.95f * ground.normal;
+      ahead - (glm::dot(normal, ahead) + static_cast<float>(ground.offset)) * normal;
+  return on_floor + 0.95f * normal;
 }
 
 std::string hello_json(const std::string& title) {
@@ -43,7 +44,7 @@ std::string hello_json(const std::string& title) {
   return Json{{"type", "hello"}, {"title", title}, {"joints", names}, {"bones", bones}}.dump();
 }
 
-std::string frame_json(const People3D& frame, const CameraView& camera,
+std::string frame_json(const People3D& frame, const std::optional<ShownCamera>& camera,
                        const std::optional<Playback>& playback, std::optional<double> time) {
   const GroundPlane ground = frame.has_ground ? frame.ground : assumed_ground();
   std::size_t unplaced = 0;
@@ -80,15 +81,17 @@ std::string frame_json(const People3D& frame, const CameraView& camera,
          {rounded(ground.normal.x, 1e4), rounded(ground.normal.y, 1e4),
           rounded(ground.normal.z, 1e4)}},
         {"offset", rounded(ground.offset, 1000)}}}};
-  Json cam = {{"known", camera.known}};
-  if (camera.known) {
-    cam.update({{"assumed", camera.assumed},
-                {"width", camera.width},
-                {"height", camera.height},
-                {"fx", rounded(camera.fx, 10)},
-                {"fy", rounded(camera.fy, 10)},
-                {"cx", rounded(camera.cx, 10)},
-                {"cy", rounded(camera.cy, 10)}});
+  Json cam = {{"known", camera.has_value()}};
+  if (camera) {
+    // In float, as the viewer always had them.
+    const camera::Camera& c = camera->camera;
+    cam.update({{"assumed", camera->assumed},
+                {"width", c.width},
+                {"height", c.height},
+                {"fx", rounded(static_cast<float>(c.fx), 10)},
+                {"fy", rounded(static_cast<float>(c.fy), 10)},
+                {"cx", rounded(static_cast<float>(c.cx), 10)},
+                {"cy", rounded(static_cast<float>(c.cy), 10)}});
   }
   out["camera"] = cam;
   if (playback) {

@@ -208,8 +208,8 @@ int main(int argc, char** argv) {
     const auto cameras = eval::default_cameras(!args.has("all-cameras"));
     const auto conditions = eval::default_conditions(!args.has("all-conditions"));
     const eval::Image image;
-    const recon::Pinhole pinhole =
-        recon::Pinhole::from_fov(image.width, image.height, image.horizontal_fov_deg);
+    const camera::Camera lens =
+        camera::Camera::from_fov(image.width, image.height, image.horizontal_fov_deg);
 
     recon::Matcher matcher(db, {});
     const recon::FrameBones bones(db);
@@ -218,11 +218,11 @@ int main(int argc, char** argv) {
     retrieval.fps = fps;
     retrieval.selection = recon::Selection::path;
     retrieval.smoothing = recon::Smoothing::savitzky_golay;
-    retrieval.camera = pinhole;
+    retrieval.camera = lens;
     retrieval.refine_view = true;
 
     fit::FitOptions options;
-    options.camera = pinhole;
+    options.camera = recon::pinhole_of(lens);
     options.ankle_clearance_m = args.number("clearance");
     if (!args.has("no-ground")) options.ground = fit::GroundPlane{{0.0, 1.0, 0.0}, 0.0};
     options.lag = static_cast<int>(args.integer("lag"));
@@ -280,7 +280,7 @@ int main(int argc, char** argv) {
           {
             Row r;
             r.pose = eval::score(poses, rendered.truth_camera);
-            r.placement = placement(fit::placed_retrieval(inputs, pinhole));
+            r.placement = placement(fit::placed_retrieval(inputs, options.camera));
             rows[{methods[1], cond}].add(r);
           }
           for (const auto& v : variants) {

@@ -16,6 +16,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "camera/camera_file.hpp"
 #include "cli_args.hpp"
 #include "commands.hpp"
 #include "core/input_error.hpp"
@@ -188,6 +189,10 @@ void configure(graph::GraphSpec& spec, const Args& args, const fs::path& out, In
   if (args.has("camera")) {
     for (const char* type : {"recon.temporal_selector", "recon.fit"})
       set_param(spec, type, "camera", args.get("camera"));
+    // The messages name their camera as the camera file does (docs/cameras.md).
+    const std::string name = camera::read_camera_file(args.get("camera")).name;
+    for (const char* type : {"source.video", "source.openpose_json"})
+      set_param(spec, type, "camera", name);
   }
   set_param(spec, "sink.jsonl", "path", (out / "poses.jsonl").string());
   set_param(spec, "sink.bvh", "dir", out.string());
@@ -259,8 +264,9 @@ int reconstruct_command(int argc, char** argv) {
               "its camera ray (off when absent; videos: always on, their own size)")
       .option("hfov", "DEG", "horizontal field of view assumed with --image-size", "60")
       .option("camera", "FILE",
-              "calibrated camera (OpenCV YAML from `mocap calibrate intrinsics`): its matrix and "
-              "lens distortion replace --image-size/--hfov for the ray through each root")
+              "calibrated camera: the OpenCV YAML of `mocap calibrate intrinsics` or any rig "
+              "file of one camera (docs/cameras.md); its matrix and lens distortion replace "
+              "--image-size/--hfov for the ray through each root")
       .option("fit", "auto|off|live|full",
               "skeleton fitting (root translation, the person's bones, feet on the floor): full "
               "over the whole sequence, live with a 3-frame lag; auto: full for files, live for "

@@ -26,34 +26,20 @@ namespace {
 
 using namespace std::chrono_literals;
 
-std::optional<web::CameraView> camera_of(const Args& args) {
-  std::optional<camera::CameraIntrinsics> lens;
-  bool assumed = false;
-  if (args.has("camera")) {
-    lens = camera::read_camera_file(args.get("camera"));
-  } else if (args.has("image-size")) {
-    const std::string size = args.get("image-size");
-    int width = 0, height = 0;
-    if (std::sscanf(size.c_str(), "%dx%d", &width, &height) != 2 || width <= 0 || height <= 0)
-      throw InputError("--image-size", "expected WIDTHxHEIGHT, got '" + size + "'");
-    lens = camera::from_fov(width, height, args.number("hfov"));
-    assumed = true;
-  }
-  if (!lens) return std::nullopt;
-  return web::CameraView{true,
-                         assumed,
-                         lens->width,
-                         lens->height,
-                         static_cast<float>(lens->fx()),
-                         static_cast<float>(lens->fy()),
-                         static_cast<float>(lens->cx()),
-                         static_cast<float>(lens->cy())};
+std::optional<web::ShownCamera> camera_of(const Args& args) {
+  if (args.has("camera")) return web::ShownCamera{camera::read_camera_file(args.get("camera"))};
+  if (!args.has("image-size")) return std::nullopt;
+  const std::string size = args.get("image-size");
+  int width = 0, height = 0;
+  if (std::sscanf(size.c_str(), "%dx%d", &width, &height) != 2 || width <= 0 || height <= 0)
+    throw InputError("--image-size", "expected WIDTHxHEIGHT, got '" + size + "'");
+  return web::ShownCamera{camera::Camera::from_fov(width, height, args.number("hfov")), true};
 }
 
 int view_recording(const Args& args) {
   const std::string path = args.positionals()[0];
   const web::Recording recording = web::read_poses_jsonl(path, args.number("fps"));
-  const web::CameraView camera = camera_of(args).value_or(web::CameraView{});
+  const std::optional<web::ShownCamera> camera = camera_of(args);
 
   std::mutex mutex;
   std::condition_variable changed;
@@ -192,7 +178,7 @@ int view_command(int argc, char** argv) {
       .option("port", "P", "TCP port; 0 picks a free one (graph: 8080 unless given)", "8080")
       .option("queue", "N", "frames waiting per browser before the oldest is dropped", "4")
       .option("fps", "F", "frame rate of a recording without usable times", "30")
-      .option("camera", "FILE", "camera file (OpenCV YAML): draw its frustum")
+      .option("camera", "FILE", "camera file (a rig file of one camera): draw its frustum")
       .option("image-size", "WxH", "or the image size, with --hfov, for an assumed camera")
       .option("hfov", "DEG", "horizontal field of view with --image-size", "60")
       .flag("quiet", "do not print the graph's statistics at the end");

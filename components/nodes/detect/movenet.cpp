@@ -43,10 +43,11 @@ class MovenetNode : public Node {
   }
 
   void process(Context& ctx) override {
+    const auto& frame = ctx.input<VideoFrame>("in");
     People2D out;
     out.layout = LayoutId::coco17;
-    for (const detect::MovenetPerson& found :
-         detector_->detect(ctx.input<VideoFrame>("in").image)) {
+    out.camera = frame.camera;
+    for (const detect::MovenetPerson& found : detector_->detect(frame.image)) {
       Person2D person;
       person.box = found.box;
       person.joints.assign(found.keypoints.begin(), found.keypoints.end());

@@ -7,7 +7,6 @@
 #include <map>
 #include <optional>
 
-#include "camera/undistortion.hpp"
 #include "core/input_error.hpp"
 #include "graph/registry.hpp"
 #include "nodes/recon/node_camera.hpp"
@@ -70,16 +69,13 @@ class TemporalSelectorNode : public Node {
   void process(Context& ctx) override {
     const auto& in = ctx.input<PoseMatches>("in");
     const std::int64_t t = next_frame_++;
-    pending_.push_back({ctx.header(), {}, {}, {}, {}});
+    pending_.push_back({ctx.header(), in.camera, {}, {}, {}, {}});
     for (const PersonMatch& person : in.people) {
       if (person.id < 0) continue;  // untracked: no history to choose with
       pending_.back().keypoints[person.id] = person.body;
-      Keypoint2D root = person.body[index(Joint::root)];
-      if (camera_.lens) {
-        const auto [x, y] = camera::undistort_pixel(*camera_.lens, root.x, root.y);
-        root.x = x, root.y = y;
-      }
-      pending_.back().root_pixel[person.id] = {root.x, root.y};
+      const Keypoint2D root = person.body[index(Joint::root)];
+      const glm::dvec2 ideal = camera_.camera.undistort_pixel({root.x, root.y});
+      pending_.back().root_pixel[person.id] = glm::vec2(ideal);
       if (person.normalized_ok) {
         posedb::PoseVector query;
         std::copy(person.normalized.begin(), person.normalized.end(), query.begin());
@@ -121,6 +117,7 @@ class TemporalSelectorNode : public Node {
   };
   struct PendingFrame {
     Header header;
+    std::string camera;  // whose frame the poses are in
     std::vector<Person3D> people;
     std::map<int, glm::vec2> root_pixel;      // of each person in this frame's input
     std::map<int, posedb::PoseVector> query;  // each person's normalised 2D pose
@@ -171,8 +168,8 @@ class TemporalSelectorNode : public Node {
       turned = recon::refined_pose_in_camera(*db_, pose.chosen, query->second);
     }
     if (const auto root = pending.root_pixel.find(id);
-        camera_.pinhole.valid() && root != pending.root_pixel.end()) {
-      recon::turn_onto_ray(turned, camera_.pinhole, root->second);
+        camera_.known() && root != pending.root_pixel.end()) {
+      recon::turn_onto_ray(turned, camera_.camera, root->second);
     }
     pending.people.push_back(to_person(id, turned, *db_));
     if (const auto body = pending.keypoints.find(id); body != pending.keypoints.end())
@@ -184,6 +181,7 @@ class TemporalSelectorNode : public Node {
     while (!pending_.empty() && first_pending_ <= last) {
       People3D out;
       out.header = pending_.front().header;
+      out.frame = CoordinateFrame::of_camera(std::move(pending_.front().camera));
       out.people = std::move(pending_.front().people);
       std::sort(out.people.begin(), out.people.end(),
                 [](const Person3D& a, const Person3D& b) { return a.id < b.id; });
@@ -200,7 +198,7 @@ class TemporalSelectorNode : public Node {
   recon::PathOptions path_;
   int lag_ = 0;
   int max_missed_ = 10;
-  NodeCamera camera_;  // pinhole invalid: poses stay as the database cameras see them
+  NodeCamera camera_;  // unknown: poses stay as the database cameras see them
   bool refine_view_ = true;
   std::map<int, Track> tracks_;
   std::deque<PendingFrame> pending_;

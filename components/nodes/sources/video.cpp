@@ -42,7 +42,8 @@ class VideoSourceNode : public Node {
     c.param<int>("height", 0, "devices: frame height to ask for (0: the device's)", {0, 16384});
     c.param<std::int64_t>("count", 0, "frames to send at most (0: all)", {0, 1e12});
     c.param<int>("timeout_ms", 10000, "network streams: open and read timeout", {100, 600000});
-    c.param<int>("camera", 0, "camera id in the messages", {0, 1000});
+    c.param<std::string>("camera", std::string(kDefaultCamera),
+                         "the camera's name in the messages (as in the rig file, docs/cameras.md)");
     c.param<std::string>("stream", "", "stream id of the messages (default: the path)");
     c.param<bool>("loop", false, "files and folders: start again at the end (counts the passes)");
   }
@@ -69,7 +70,7 @@ class VideoSourceNode : public Node {
     }
     count_ = ctx.param<std::uint64_t>("count");
     loop_ = ctx.param<bool>("loop") && !source_->live();
-    camera_id_ = ctx.param<int>("camera");
+    camera_ = ctx.param<std::string>("camera");
     stream_ = ctx.param<std::string>("stream");
     if (stream_.empty()) stream_ = path;
     if (options.decoder_threads > 0 && !video::decoder_threads_supported()) {
@@ -105,7 +106,7 @@ class VideoSourceNode : public Node {
     last_media_time_s_ = frame->media_time_s;
     VideoFrame message;
     message.header = {stream_, sent_, stamp, frame->index};
-    message.camera_id = camera_id_;
+    message.camera = camera_;
     message.image = std::move(frame->image);
     ctx.send("frames", std::move(message));
     ++sent_;
@@ -173,7 +174,7 @@ class VideoSourceNode : public Node {
   double pass_offset_s_ = 0.0, last_media_time_s_ = 0.0;
   std::uint64_t count_ = 0, sent_ = 0, skipped_ = 0;
   std::int64_t start_ns_ = 0;
-  int camera_id_ = 0;
+  std::string camera_;
   std::string stream_;
 };
 
