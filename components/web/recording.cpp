@@ -103,6 +103,10 @@ Recording read_poses_jsonl(const std::string& path, double fps) {
       if (!has_time || (!out.times.empty() && time < out.times.back())) times_ok = false;
       out.times.push_back(time);
     } catch (const std::exception& e) {
+      if (in.eof() && !out.frames.empty()) {  // no newline after it: cut by a kill
+        out.cut_last_line = true;
+        break;
+      }
       throw InputError(path, line, std::string("not a poses.jsonl line: ") + e.what());
     }
   }

@@ -7,16 +7,22 @@
 // whose root translation is estimated (recon.fit), `keypoints` (the 15 body joints' 2D input, image
 // pixels as detected and confidence, 0 0 0 where missing) for people reconstructed from a 2D
 // detection, so that a recording can be replayed beside its input (mocap view), `ground` once the
-// floor is known (points p
-// with normal . p + offset = 0, normal up). Each line is flushed as it is written, so the file
-// holds every finished frame even if the run is killed.
+// floor is known (points p with normal . p + offset = 0, normal up).
+//
+// The file is created when the first frame arrives (a run that fails before leaves an earlier
+// file untouched). Each line is one write, flushed, so the file holds every finished frame even
+// if the run is killed; a kill in the middle of a write can only leave the last line cut, without
+// its newline (readers skip such a tail: web::read_poses_jsonl, mocap reconstruct's summary).
+
+#include <fcntl.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
-#include <cstdio>
 #include <cstring>
-#include <memory>
+#include <filesystem>
+#include <string_view>
 
 #include <nlohmann/json.hpp>
 
@@ -31,15 +37,38 @@ class JsonLinesSink : public Node {
   static void contract(Contract& c) {
     c.doc("Writes one JSON line per frame with every person's 15 joints");
     c.input<People3D>("in");
-    c.required_param<std::string>("path", "file to write (poses.jsonl)");
+    c.required_param<std::string>(
+        "path", "file to write (poses.jsonl; created, with its folder, at the first frame)");
   }
+  // The file is created when the first frame arrives, so that a run failing before it (a busy
+  // port, a bad parameter of another node) leaves an earlier file of that name untouched; that
+  // its folder takes files is checked now, so such a run still fails before it starts.
   void open(Context& ctx) override {
     path_ = ctx.param<std::string>("path");
-    file_.reset(std::fopen(path_.c_str(), "w"));
-    if (!file_)
-      throw InputError(path_, std::string("cannot create the file: ") + std::strerror(errno));
+    if (::access(path_.c_str(), F_OK) == 0) {
+      if (::access(path_.c_str(), W_OK) != 0)
+        throw InputError(path_, std::string("cannot write the file: ") + std::strerror(errno));
+      return;
+    }
+    // The folder is made with the file; the nearest one that exists must take it.
+    std::filesystem::path folder = std::filesystem::absolute(path_).parent_path();
+    std::error_code ec;
+    while (!std::filesystem::exists(folder, ec) && folder.has_relative_path())
+      folder = folder.parent_path();
+    if (::access(folder.c_str(), W_OK | X_OK) != 0)
+      throw InputError(
+          path_, "cannot create the file in " + folder.string() + ": " + std::strerror(errno));
   }
   void process(Context& ctx) override {
+    if (!file_) {
+      const std::filesystem::path folder = std::filesystem::path(path_).parent_path();
+      std::error_code ec;
+      if (!folder.empty()) std::filesystem::create_directories(folder, ec);
+      if (ec) throw InputError(folder.string(), "cannot create the folder: " + ec.message());
+      file_.reset(::open(path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644));
+      if (!file_)
+        throw InputError(path_, std::string("cannot create the file: ") + std::strerror(errno));
+    }
     const auto& in = ctx.input<People3D>("in");
     nlohmann::ordered_json people = nlohmann::ordered_json::array();
     for (const Person3D& p : in.people) {
@@ -56,11 +85,7 @@ class JsonLinesSink : public Node {
                         {"offset", round_mm(in.ground.offset)}};
     }
     const std::string text = line.dump() + "\n";
-    if (std::fwrite(text.data(), 1, text.size(), file_.get()) != text.size() ||
-        std::fflush(file_.get()) != 0) {
-      throw InputError(path_, std::string("write failed: ") + std::strerror(errno) +
-                                  " (disk full or over the file size limit?)");
-    }
+    write_line(text);
   }
   void close(Context&) override { file_.reset(); }
 
@@ -90,11 +115,39 @@ class JsonLinesSink : public Node {
   }
   // Millimetre precision keeps the file small and the numbers readable.
   static double round_mm(float v) { return std::round(static_cast<double>(v) * 1000.0) / 1000.0; }
-  struct Closer {
-    void operator()(std::FILE* f) const { std::fclose(f); }
+  // One write() per line (retried only if the kernel writes part of it); on a failure the file
+  // is cut back to its last whole line, so it stays valid.
+  void write_line(std::string_view text) {
+    std::string_view rest = text;
+    while (!rest.empty()) {
+      const ssize_t n = ::write(file_.get(), rest.data(), rest.size());
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) {
+        const int error = n == 0 ? EIO : errno;
+        [[maybe_unused]] const int cut = ::ftruncate(file_.get(), end_);  // best effort
+        throw InputError(path_, std::string("write failed: ") + std::strerror(error) +
+                                    " (disk full or over the file size limit?)");
+      }
+      rest.remove_prefix(static_cast<std::size_t>(n));
+    }
+    end_ += static_cast<off_t>(text.size());
+  }
+  struct Fd {
+    int fd = -1;
+    Fd() = default;
+    Fd(const Fd&) = delete;
+    Fd& operator=(const Fd&) = delete;
+    ~Fd() { reset(); }
+    void reset(int to = -1) {
+      if (fd >= 0) ::close(fd);
+      fd = to;
+    }
+    int get() const { return fd; }
+    explicit operator bool() const { return fd >= 0; }
   };
   std::string path_;
-  std::unique_ptr<std::FILE, Closer> file_;
+  Fd file_;
+  off_t end_ = 0;  // size after the last whole line
 };
 
 MOCAP_REGISTER_NODE("sink.jsonl", JsonLinesSink)
