@@ -2,7 +2,8 @@
 // output that is one of the inputs is refused naming both (export, db build, retarget,
 // reconstruct, eval); numeric options out of range are refused before anything runs; a busy port
 // or a node failing before the first frame leaves an existing poses.jsonl untouched; paths with
-// bytes that are not UTF-8 work and the JSON written stays valid; an evaluation refuses a database
+// bytes that are not UTF-8 work and the JSON written stays valid; an HTTP stream that stops before
+// the frames it announced ends the run like a truncated file; an evaluation refuses a database
 // built from the motion it evaluates on, or with --allow-leak says so in its report.
 
 #include <gtest/gtest.h>
@@ -12,7 +13,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include "detect/model_files.hpp"
 #include "support/files.hpp"
+#include "support/http_file_server.hpp"
 #include "support/mocap_process.hpp"
 #include "support/network.hpp"
 #include "support/shared_data.hpp"
@@ -25,6 +28,7 @@ using namespace std::chrono_literals;
 
 const fs::path kCmu = test::shared_data() / "mocap" / "cmu31";
 const fs::path kJson = test::shared_data() / "eval" / "openpose_json" / "json";
+const fs::path kVideo = test::shared_data() / "eval" / "opencv_samples" / "vtest_part0.avi";
 
 // A name with bytes that are not UTF-8 (Latin-1 é, and 0xff).
 const std::string kNotUtf8 = "caf\xe9-\xff";
@@ -215,6 +219,52 @@ TEST_F(OutputIntegrityTest, PathsWithBytesThatAreNotUtf8WorkAndTheJsonStaysValid
   EXPECT_FALSE(summary.at("files").empty());
   EXPECT_EQ(test::read_lines(out + "/poses.jsonl").size(), 12u);
   EXPECT_NE(reconstruct.out().find(out + "/poses.jsonl"), std::string::npos) << reconstruct.out();
+}
+
+TEST_F(OutputIntegrityTest, OptionsThatContradictTheInputAreRefusedBeforeAnythingIsWritten) {
+  // --fps against a video's own rate (vtest_part0 is 10 fps): BVH and overlay would disagree
+  // with poses.jsonl's times.
+  if (fs::exists(kVideo)) {
+    auto fps = run("fps", {"reconstruct", kVideo.string(), "--db", dir_->file("db.mdb"), "--out",
+                           dir_->file("fps"), "--fps", "25"});
+    ASSERT_EQ(fps.wait(60s), 1) << fps.err();
+    EXPECT_NE(fps.err().find("runs at 10 frames/s"), std::string::npos) << fps.err();
+    EXPECT_FALSE(fs::exists(dir_->file("fps")));
+  }
+  // An image size smaller than where the keypoints are (the badminton clip's are 1920x1080).
+  auto size = run("size", {"reconstruct", dir_->file("json"), "--db", dir_->file("db.mdb"), "--out",
+                           dir_->file("size"), "--image-size", "1280x720"});
+  ASSERT_EQ(size.wait(60s), 1) << size.err();
+  EXPECT_NE(size.err().find("--image-size: 1280x720 is smaller than the keypoints"),
+            std::string::npos)
+      << size.err();
+  EXPECT_NE(size.err().find("_keypoints.json"), std::string::npos) << size.err();
+  EXPECT_FALSE(fs::exists(dir_->file("size")));
+}
+
+TEST_F(OutputIntegrityTest, AStreamThatStopsEarlyEndsTheRunLikeATruncatedFile) {
+  if (!fs::exists(kVideo)) GTEST_SKIP() << "shared video absent: " << kVideo;
+  try {
+    detect::movenet_model_json();
+  } catch (const detect::ModelMissing&) {
+    GTEST_SKIP() << "MoveNet model absent: tools/setup.sh --models-only";
+  }
+  const std::string bytes = test::read_file(kVideo.string());
+  const test::HttpFileServer server(bytes, bytes.size() / 4);  // the connection lost at a quarter
+  const std::string url = server.url("vtest_part0.avi");
+  const std::string out = dir_->file("stream");
+  auto stream =
+      run("stream", {"reconstruct", url, "--db", dir_->file("db.mdb"), "--out", out, "--quiet"});
+  ASSERT_EQ(stream.wait(300s), 1) << stream.err();
+  EXPECT_NE(stream.err().find(url), std::string::npos) << stream.err();
+  EXPECT_NE(stream.err().find("stopped early"), std::string::npos) << stream.err();
+  const auto summary = nlohmann::json::parse(test::read_file(out + "/summary.json"));
+  EXPECT_FALSE(summary.at("completed").get<bool>());
+  const auto lines = test::read_lines(out + "/poses.jsonl");
+  EXPECT_GT(lines.size(), 10u);  // the frames before the cut are kept
+  EXPECT_LT(lines.size(), 200u);
+  for (const auto& line : lines)
+    EXPECT_FALSE(nlohmann::json::parse(line, nullptr, false).is_discarded()) << line;
 }
 
 TEST_F(OutputIntegrityTest, AnEvaluationRefusesADatabaseOfItsHeldOutMotionUnlessAllowed) {

@@ -30,7 +30,7 @@ using namespace std::chrono_literals;
 const fs::path kCmu = test::shared_data() / "mocap" / "cmu31";
 const fs::path kJson = test::shared_data() / "eval" / "openpose_json" / "json";
 const fs::path kVideo = test::shared_data() / "eval" / "opencv_samples" / "vtest_part0.avi";
-constexpr std::size_t kJsonFrames = 200;
+constexpr std::size_t kJsonFrames = 120;  // more than the 64 frames an overlay once held back
 
 bool model_present() {
   try {
@@ -126,10 +126,11 @@ class ReconstructKillTest : public ::testing::Test {
     if (!dir_) GTEST_SKIP() << "shared data absent (" << kCmu << ", " << kJson << ")";
   }
 
-  // The default job on `input` (`extra`: the JSON's image size), stopped by `signal` once
-  // poses.jsonl holds `lines` frames (0: as soon as the run has started).
+  // The default job on `input` (`extra`: the JSON's image size; `total_frames` in it), stopped by
+  // `signal` once poses.jsonl holds `lines` frames (0: as soon as the run has started).
   static void interrupt(const std::string& name, const std::string& input,
-                        const std::vector<std::string>& extra, int signal, std::size_t lines) {
+                        const std::vector<std::string>& extra, std::size_t total_frames, int signal,
+                        std::size_t lines) {
     const std::string when = name + " " + (signal == SIGINT ? "SIGINT" : "SIGKILL") + " at " +
                              std::to_string(lines) + " lines";
     const fs::path out =
@@ -144,8 +145,15 @@ class ReconstructKillTest : public ::testing::Test {
     while (lines > 0 && complete_line_count(poses) < lines &&
            std::chrono::steady_clock::now() < deadline)
       std::this_thread::sleep_for(5ms);
-    ASSERT_GE(complete_line_count(poses), lines) << when << ": " << run.err();
+    const std::size_t seen = complete_line_count(poses);
+    ASSERT_GE(seen, lines) << when << ": " << run.err();
     kill(run.pid(), signal);
+    // The results stream out: poses.jsonl grows during the run, it does not go from nothing to
+    // every frame at the end.
+    if (lines > 0) {
+      EXPECT_LT(seen, total_frames) << when << ": poses.jsonl went from fewer than " << lines
+                                    << " lines to all " << seen << " at once";
+    }
     const auto code = run.wait(60s);
     ASSERT_TRUE(code.has_value()) << when;
     // Interrupted, not finished: the frames were written while the run went on.
@@ -181,22 +189,22 @@ class ReconstructKillTest : public ::testing::Test {
 TEST_F(ReconstructKillTest, AnInterruptedOpenPoseRunKeepsWholeFiles) {
   const std::vector<std::string> camera = {"--image-size", "1920x1080", "--fps", "25"};
   for (const int signal : {SIGINT, SIGKILL})
-    for (const std::size_t lines : {std::size_t{0}, std::size_t{10}, std::size_t{60}})
-      interrupt("json", dir_->file("json"), camera, signal, lines);
+    for (const std::size_t lines : {std::size_t{0}, std::size_t{10}, std::size_t{40}})
+      interrupt("json", dir_->file("json"), camera, kJsonFrames, signal, lines);
 }
 
 TEST_F(ReconstructKillTest, AnInterruptedVideoRunKeepsWholeFiles) {
   if (!fs::exists(kVideo)) GTEST_SKIP() << "shared video absent: " << kVideo;
   if (!model_present()) GTEST_SKIP() << "MoveNet model absent: tools/setup.sh --models-only";
   for (const int signal : {SIGINT, SIGKILL})
-    for (const std::size_t lines : {std::size_t{0}, std::size_t{10}, std::size_t{60}})
-      interrupt("video", kVideo.string(), {}, signal, lines);
+    for (const std::size_t lines : {std::size_t{0}, std::size_t{10}, std::size_t{40}})
+      interrupt("video", kVideo.string(), {}, 200, signal, lines);
 }
 
 // The overlay draws every input frame, whatever the fitting (off: as frames come; live: 3 frames
 // late; full: at the end of each window or of the sequence).
 TEST_F(ReconstructKillTest, TheOverlayHoldsEveryInputFrameForEveryFit) {
-  const std::size_t video_frames = 40;
+  const std::size_t video_frames = 100;  // more than the 64 frames an overlay once held back
   for (const std::string fit : {"off", "live", "full"}) {
     if (fs::exists(kVideo) && model_present()) {
       const std::string out = dir_->file("overlay_video_" + fit);

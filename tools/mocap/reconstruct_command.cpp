@@ -346,10 +346,9 @@ void print_written(const fs::path& out, const WrittenOutputs& written, const jso
 std::string incomplete_note(const WrittenOutputs& written, const json& summary,
                             std::int64_t input_frames) {
   std::ostringstream note;
-  note << "kept what it wrote before it ended (the files above, each whole): "
-       << summary["frames"].get<std::size_t>();
-  if (input_frames > 0) note << " of the " << input_frames;
-  note << " input frames";
+  note << "kept what it wrote before it ended (the files above, each whole): poses.jsonl holds "
+       << summary["frames"].get<std::size_t>() << " frames";
+  if (input_frames > 0) note << " of the " << input_frames << " the input announced";
   std::vector<std::string> missing;
   if (written.poses.empty()) missing.push_back("poses.jsonl");
   if (written.bvh.empty()) missing.push_back("any person_<id>.bvh");
