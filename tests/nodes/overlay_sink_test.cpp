@@ -1,5 +1,6 @@
 // sink.overlay in a graph: a playable MP4 with one picture per frame that had both inputs, PNG
-// snapshots, the optional video input under the 2D people, and errors naming the file.
+// snapshots, the optional video input under the 2D people or the frames read again from the file
+// (video_path), and errors naming the file.
 
 #include <cstdio>
 #include <filesystem>
@@ -9,6 +10,7 @@
 
 #include "sink_test_util.hpp"
 #include "support/small_pose_database.hpp"
+#include "video/mp4_writer.hpp"
 
 namespace mocap::nodes {
 namespace {
@@ -88,6 +90,45 @@ edges:
   const cv::Vec3b corner = picture.at<cv::Vec3b>(470, 840);
   EXPECT_NEAR(corner[2], 200, 8);
   EXPECT_LT(corner[0] + corner[1], 16);
+}
+
+// With video_path the overlay reads the frame under the 2D people from the file by frame number
+// (the script's frames 0..11 are the file's frames 0..11, each its own grey), and the video port
+// is not needed.
+TEST(OverlaySink, VideoPathFramesAreReadAgainByFrameNumber) {
+  MOCAP_REQUIRE_SMALL_DATABASE(db);
+  test::TempDir dir;
+  const std::string clip = dir.file("clip.mp4");
+  {
+    video::Mp4Writer writer(clip, 320, 180, {10.0});
+    for (int k = 0; k < 12; ++k) {
+      ImageBuffer grey(320, 180, PixelFormat::bgr8);
+      for (std::byte& b : grey.pixels_for_writing()) b = std::byte(20 * k);
+      writer.write(grey);
+    }
+  }
+  const graph::RunResult result = run_graph(R"(
+nodes:
+  src: { type: unit.people_script, params: { db: )" +
+                                            db + ", script: \"" + two_people_script(12) + R"(" } }
+  overlay: { type: sink.overlay, params: { video_path: )" +
+                                            clip + ", video: " + dir.file("overlay.mp4") +
+                                            ", png_every: 1, png_dir: " + dir.file("png") + R"( } }
+edges:
+  - [src.people2d, overlay.people2d]
+  - [src.people3d, overlay.people3d]
+)");
+  ASSERT_TRUE(result.ok) << result.error;
+  cv::Size size;
+  EXPECT_EQ(count_video_frames(dir.file("overlay.mp4"), size), 12);
+  for (int k = 0; k < 12; ++k) {
+    char name[32];
+    std::snprintf(name, sizeof name, "png/overlay_%06d.png", k);
+    const cv::Mat picture = cv::imread(dir.file(name));
+    ASSERT_FALSE(picture.empty()) << name;
+    const cv::Vec3b corner = picture.at<cv::Vec3b>(470, 840);  // the video, away from people
+    EXPECT_NEAR(corner[1], 20 * k, 4) << name;
+  }
 }
 
 TEST(OverlaySink, UnwritableVideoFailsTheGraphNamingTheFile) {
