@@ -128,18 +128,18 @@ void draw_people_2d(const OverlayRenderer& r, cv::Mat& left, const People2D& peo
 }
 
 // Grid lines on the floor every `step` metres, the step the smallest of 0.5, 1, 2, 5, 10 m that
-// leaves 14 pixels between lines, over the floor the panel shows; fixed to the floor, so the grid
+// leaves 24 pixels between lines, over the floor the panel shows; fixed to the floor, so the grid
 // moves with the view, not with the people.
 void draw_floor(cv::Mat& right, const SceneCamera& camera) {
   float step = 10.0f;
   for (float s : {0.5f, 1.0f, 2.0f, 5.0f}) {
-    if (s * camera.pixels_per_metre() >= 14.0f) {
+    if (s * camera.pixels_per_metre() >= 24.0f) {
       step = s;
       break;
     }
   }
   const auto [x0, a0, x1, a1] = camera.visible_floor(step);
-  const cv::Scalar grid(66, 66, 66);
+  const cv::Scalar grid(56, 56, 56);
   auto at = [&](float x, float ahead) { return pixel(camera.project_floor({x, 0.0f, ahead})); };
   for (float x = x0; x <= x1 + 1e-3f; x += step)
     cv::line(right, at(x, a0), at(x, a1), grid, 1, cv::LINE_AA);

@@ -34,7 +34,7 @@ struct OverlayOptions {
   int canvas_height = 1080;
   int panel_height = 480;         // output height; each panel is scaled to it
   float view_yaw_deg = 35.0f;     // 3D panel: camera turned about the vertical from the input's
-  float view_pitch_deg = 20.0f;   // ...and looking down by this much
+  float view_pitch_deg = 30.0f;   // ...and looking down by this much
   float person_spacing_m = 1.2f;  // 3D panel: distance between unplaced people in their row
 };
 

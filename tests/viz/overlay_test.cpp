@@ -308,7 +308,7 @@ TEST(ScenePanel, PlacedPeopleStandWhereTheFitPutThemUprightOnTheFloorGrid) {
   EXPECT_LT(roots[1].y, roots[0].y);
   EXPECT_GT(roots[1].x, roots[0].x);
   // Both were placed: nobody stands in a row, and the floor grid is drawn.
-  EXPECT_GT(pixels_near(image, {66, 66, 66}, renderer.panel_width(), renderer.width()), 300);
+  EXPECT_GT(pixels_near(image, {56, 56, 56}, renderer.panel_width(), renderer.width()), 300);
 }
 
 TEST(ScenePanel, UnplacedPeopleStandInARowOnTheFloorBesidePlacedOnes) {

@@ -43,7 +43,7 @@ class OverlaySink : public Node {
                           {16, 16384});
     c.param<std::int64_t>("panel_height", 480, "output height in pixels", {16, 16384});
     c.param<double>("view_yaw_deg", 35.0, "3D view: turn about the vertical", {-180.0, 180.0});
-    c.param<double>("view_pitch_deg", 20.0, "3D view: looking down by", {-89.0, 89.0});
+    c.param<double>("view_pitch_deg", 30.0, "3D view: looking down by", {-89.0, 89.0});
     c.param<std::int64_t>("max_pending", 64, "incomplete frames kept at most", {1, 100000});
     c.param<bool>("wait_for_video", false, "draw a frame only once its video frame is there");
   }
