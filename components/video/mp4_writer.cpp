@@ -121,7 +121,8 @@ struct Mp4Writer::Impl {
     if (codec->id == AV_CODEC_ID_H264) {
       // zerolatency: no look-ahead, no B-frames, sliced threads: a frame leaves the encoder as
       // soon as it went in, so the file on disk is never more than a frame behind.
-      av_opt_set(c.priv_data, "preset", "veryfast", 0);
+      if (av_opt_set(c.priv_data, "preset", options.h264_preset.c_str(), 0) < 0)
+        fail("unknown H.264 preset '" + options.h264_preset + "'");
       av_opt_set(c.priv_data, "tune", "zerolatency", 0);
       av_opt_set(c.priv_data, "crf", "23", 0);
     } else {

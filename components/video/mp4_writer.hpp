@@ -3,8 +3,9 @@
 // first, then one fragment per frame, each handed to the operating system as soon as it is
 // encoded), so a process killed at any time, SIGKILL included, leaves a file that FFmpeg-based
 // players (and cv::VideoCapture) decode up to the last frame it wrote, at worst up to the one
-// before. H.264 (libx264, no B-frames and no look-ahead, so no frame waits inside the encoder)
-// when this FFmpeg has it, else MPEG-4 Part 2. libav stays inside the .cpp file.
+// before. H.264 (libx264, preset superfast, no B-frames and no look-ahead, so no frame waits inside
+// the encoder) when this FFmpeg has it, else MPEG-4 Part 2. libav stays inside the .cpp file.
+// Costs and sizes against cv::VideoWriter: docs/overlay.md (mocap-bench-overlay).
 //
 // A file written through cv::VideoWriter (or any non-fragmented MP4) has its index at the end: a
 // process killed before closing it leaves a file nothing plays.
@@ -25,6 +26,8 @@ struct Mp4WriterOptions {
   Mp4Codec codec = Mp4Codec::automatic;  // automatic: H.264 when libx264 is there, else MPEG-4
   int keyframe_interval = 0;  // frames from one keyframe to the next (seeking); 0: one second
   int threads = 1;            // encoder threads (0: FFmpeg's choice, one per core)
+  // libx264's speed/size trade-off: ultrafast, superfast, veryfast, faster, fast, medium, ...
+  std::string h264_preset = "superfast";
 };
 
 // Whether this FFmpeg can encode H.264 (its libx264 encoder).
