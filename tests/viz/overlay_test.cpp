@@ -371,7 +371,7 @@ TEST(ScenePanel, ViewGrowsAtOnceAndShrinksSlowly) {
       EXPECT_TRUE(in_right_panel(renderer, renderer.scene_pixel(q))) << "person " << p.id;
   renderer.render({}, near_only, {}, {2, 0.0});
   EXPECT_LT(renderer.scene_camera().pixels_per_metre(), 1.2f * wide);  // no jump back
-  for (int f = 3; f < 200; ++f) renderer.render({}, near_only, {}, {f, 0.0});
+  for (int f = 3; f < 100; ++f) renderer.render({}, near_only, {}, {f, 0.0});
   EXPECT_NEAR(renderer.scene_camera().pixels_per_metre(), close_up, 0.02f * close_up);
 }
 
