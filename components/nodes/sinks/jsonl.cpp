@@ -38,33 +38,18 @@ class JsonLinesSink : public Node {
     c.doc("Writes one JSON line per frame with every person's 15 joints");
     c.input<People3D>("in");
     c.required_param<std::string>(
-        "path", "file to write (poses.jsonl; created, with its folder, at the first frame)");
+        "path",
+        "file to write (poses.jsonl; its folder made at the start, the file at the first frame)");
   }
   // The file is created when the first frame arrives, so that a run failing before it (a busy
   // port, a bad parameter of another node) leaves an earlier file of that name untouched; that
-  // its folder takes files is checked now, so such a run still fails before it starts.
+  // it can be written is checked now, without touching it, so such a run still fails at once.
   void open(Context& ctx) override {
     path_ = ctx.param<std::string>("path");
-    if (::access(path_.c_str(), F_OK) == 0) {
-      if (::access(path_.c_str(), W_OK) != 0)
-        throw InputError(path_, std::string("cannot write the file: ") + std::strerror(errno));
-      return;
-    }
-    // The folder is made with the file; the nearest one that exists must take it.
-    std::filesystem::path folder = std::filesystem::absolute(path_).parent_path();
-    std::error_code ec;
-    while (!std::filesystem::exists(folder, ec) && folder.has_relative_path())
-      folder = folder.parent_path();
-    if (::access(folder.c_str(), W_OK | X_OK) != 0)
-      throw InputError(
-          path_, "cannot create the file in " + folder.string() + ": " + std::strerror(errno));
+    check_writable(path_);
   }
   void process(Context& ctx) override {
     if (!file_) {
-      const std::filesystem::path folder = std::filesystem::path(path_).parent_path();
-      std::error_code ec;
-      if (!folder.empty()) std::filesystem::create_directories(folder, ec);
-      if (ec) throw InputError(folder.string(), "cannot create the folder: " + ec.message());
       file_.reset(::open(path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644));
       if (!file_)
         throw InputError(path_, std::string("cannot create the file: ") + std::strerror(errno));
@@ -115,6 +100,33 @@ class JsonLinesSink : public Node {
   }
   // Millimetre precision keeps the file small and the numbers readable.
   static double round_mm(float v) { return std::round(static_cast<double>(v) * 1000.0) / 1000.0; }
+  // An existing file is opened for writing and closed (not truncated); for a new one its folder
+  // is made and a file created and removed beside it (access() says yes to root even in /proc).
+  static void check_writable(const std::string& path) {
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    if (fs::exists(path, ec)) {
+      const int fd = ::open(path.c_str(), O_WRONLY | O_NONBLOCK | O_CLOEXEC);
+      if (fd < 0)
+        throw InputError(path, std::string("cannot write the file: ") + std::strerror(errno));
+      ::close(fd);
+      return;
+    }
+    const fs::path folder = fs::path(path).parent_path();
+    if (!folder.empty() && !fs::create_directories(folder, ec) && ec)
+      throw InputError(path, "cannot create the file: " + ec.message());
+    // Built by append: GCC 12 warns (falsely, -Wrestrict) on "." + name + ".probe".
+    std::string probe_name = ".";
+    probe_name.append(fs::path(path).filename().string()).append(".probe");
+    const fs::path probe = (folder.empty() ? fs::path(".") : folder) / probe_name;
+    const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+    if (fd < 0 && errno != EEXIST)
+      throw InputError(path, std::string("cannot create the file: ") + std::strerror(errno));
+    if (fd >= 0) {
+      ::close(fd);
+      ::unlink(probe.c_str());
+    }
+  }
   // One write() per line (retried only if the kernel writes part of it); on a failure the file
   // is cut back to its last whole line, so it stays valid.
   void write_line(std::string_view text) {
