@@ -3,6 +3,7 @@
 // playback clock the page controls (play, pause, seek, speed), looping at the end.
 
 #include <cstddef>
+#include <iosfwd>
 #include <string>
 #include <vector>
 
@@ -22,6 +23,8 @@ struct Recording {
 // it is skipped (cut_last_line). Throws mocap::InputError naming the file and line for anything
 // else it cannot read, or an empty file.
 Recording read_poses_jsonl(const std::string& path, double fps = 30.0);
+// The same from a stream; `name` stands for the file in messages.
+Recording parse_poses_jsonl(std::istream& in, const std::string& name, double fps = 30.0);
 
 class Player {
  public:
