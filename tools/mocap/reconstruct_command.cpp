@@ -396,15 +396,17 @@ int reconstruct_command(int argc, char** argv) {
       "fitted), overlay.mp4 (the input beside the 3D skeletons) and summary.json (what was run\n"
       "and the files it wrote).\n\n"
       "DIR holding an earlier run's output (poses.jsonl, summary.json, person_*.bvh, overlay*) is\n"
-      "refused, naming what is there, unless --force: then those files are removed (other files\n"
-      "stay) once the input, database, camera file and graph have been checked, before the run.\n"
+      "refused, naming what is there, unless --force: then those files (only those) are set aside\n"
+      "once the input, database, camera file and graph have been checked, removed when the run "
+      "has\n"
+      "written its output, put back as they were when it wrote none (it failed at the start).\n"
       "Files are written as the run goes and stay whole, so an interrupted run (Ctrl-C, a kill)\n"
       "keeps what it wrote under the files' own names; summary.json is written at the end.");
   args.positional("INPUT",
                   "video file, /dev/videoN, rtsp:// or http:// URL, image folder, or "
                   "folder of OpenPose *_keypoints.json files")
       .option("out", "DIR", "output folder (created)")
-      .flag("force", "replace an earlier run's output in DIR (removed before this run starts)")
+      .flag("force", "replace an earlier run's output in DIR (see above)")
       .option("db", "FILE", "pose database", default_database())
       .option("fps", "N",
               "frame rate of image folders and OpenPose JSON (30 when absent), and the rate asked "
