@@ -5,7 +5,8 @@
 # with MoveNet, reconstructs their 3D motion and says where the results are.
 #
 #   tools/demo.sh [--out DIR] [--input VIDEO|FOLDER] [--detector-size N] [-- more reconstruct options]
-#   defaults: out/, /usr/share/doc/opencv-doc/examples/data/vtest.avi, 512 (its people are small)
+#   defaults: out/, /usr/share/doc/opencv-doc/examples/data/vtest.avi, 512 (its people are small);
+#   a second demo replaces the first's output in DIR
 set -euo pipefail
 
 repo=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
@@ -62,7 +63,10 @@ if [[ -z "$input" ]]; then
 fi
 [[ -e "$input" ]] || { echo "demo.sh: no such input: $input" >&2; exit 1; }
 echo "reconstructing $input (MoveNet at $size) into $out"
-"$mocap" reconstruct "$input" --db "$db" --out "$out" --detector-size "$size" --quiet "${extra[@]}"
+# --force: a demo run again replaces the output of the one before (reconstruct refuses a folder
+# holding an earlier run's output otherwise); other files in the folder are left alone.
+"$mocap" reconstruct "$input" --db "$db" --out "$out" --force --detector-size "$size" --quiet \
+  "${extra[@]}"
 echo
 echo "Open $out/overlay.mp4 to watch the video with every person's keypoints and id beside their 3D"
 echo "skeletons; $out/person_<id>.bvh import into Blender, MotionBuilder or Maya; $out/poses.jsonl has"

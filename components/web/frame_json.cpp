@@ -29,7 +29,9 @@ std::string hello_json(const std::string& title) {
   }
   Json names = Json::array();
   for (const auto name : kJointNames) names.push_back(std::string(name));
-  return Json{{"type", "hello"}, {"title", title}, {"joints", names}, {"bones", bones}}.dump();
+  // The title is often a file name, which may hold bytes that are not UTF-8.
+  return Json{{"type", "hello"}, {"title", title}, {"joints", names}, {"bones", bones}}.dump(
+      -1, ' ', false, Json::error_handler_t::replace);
 }
 
 std::string frame_json(const People3D& frame, const CameraView& camera,

@@ -1,7 +1,7 @@
 // source.video in a graph: offline it sends every frame stamped with its time in the video;
 // live it replays a file at the file's rate with wall-clock capture times and skips frames a
-// slow consumer made late (counted); a truncated video and an absent camera stop the graph with
-// an error naming the node and the input.
+// slow consumer made late (counted); a truncated video, a stream that stops before the frames it
+// announced and an absent camera stop the graph with an error naming the node and the input.
 
 #include <gtest/gtest.h>
 
@@ -14,6 +14,7 @@
 #include "graph/transport.hpp"
 #include "sink_test_util.hpp"
 #include "support/files.hpp"
+#include "support/http_file_server.hpp"
 
 namespace mocap::nodes {
 namespace {
@@ -139,6 +140,33 @@ TEST(VideoSourceNode, ATruncatedVideoStopsTheGraphNamingTheNodeAndTheFile) {
   EXPECT_NE(result.error.find(copy), std::string::npos) << result.error;
   EXPECT_NE(result.error.find("truncated"), std::string::npos) << result.error;
   EXPECT_GT(seen.size(), 10u);  // the frames before the cut went through
+}
+
+// The clip served over HTTP: whole, every frame arrives and the stream ends; cut after half its
+// bytes (the connection lost), the graph stops with an error naming the stream, after the frames
+// that arrived, as it does for a truncated file.
+TEST(VideoSourceNode, AStreamThatStopsMidFileStopsTheGraphLikeATruncatedFile) {
+  if (!fs::exists(kVtestPart)) GTEST_SKIP() << "shared video absent: " << kVtestPart;
+  const std::string bytes = test::read_file(kVtestPart);
+  {
+    const test::HttpFileServer whole(bytes);
+    seen.clear();
+    const RunResult result = testing::run_graph(
+        graph_yaml("path: '" + whole.url("vtest.avi") + "', mode: offline, timeout_ms: 5000"));
+    ASSERT_TRUE(result.ok) << result.error;
+    EXPECT_EQ(seen.size(), 200u);
+  }
+  const test::HttpFileServer cut(bytes, bytes.size() / 2);
+  const std::string url = cut.url("vtest.avi");
+  seen.clear();
+  const RunResult result =
+      testing::run_graph(graph_yaml("path: '" + url + "', mode: offline, timeout_ms: 5000"));
+  ASSERT_FALSE(result.ok) << seen.size() << " frames and no error";
+  EXPECT_NE(result.error.find("'src'"), std::string::npos) << result.error;
+  EXPECT_NE(result.error.find(url), std::string::npos) << result.error;
+  EXPECT_NE(result.error.find("stopped early"), std::string::npos) << result.error;
+  EXPECT_GT(seen.size(), 10u);  // the frames before the cut went through
+  EXPECT_LT(seen.size(), 200u);
 }
 
 // A copy of the clip with 20000 random bytes at a quarter, half and three quarters of it: FFmpeg

@@ -9,6 +9,11 @@
 // Live frames are stamped with their capture time (CLOCK_REALTIME). Either way, put a `latest` edge
 // after this node so that a slow consumer takes the newest frame.
 //
+// The end: a file, or a file served over HTTP/RTSP, that stops well before the frames its
+// container announces (truncated, connection lost) stops the graph with an error naming the input,
+// so the run ends incomplete (exit 1) instead of looking finished; a live stream announces no
+// count and ends when its sender stops.
+//
 // loop: a file or folder starts again at its end (soak tests, installations); sequence numbers
 // go on counting, offline stamps go on from the end of the previous pass. Damaged frames that
 // FFmpeg could not decode are skipped: counted as drops, logged and shown in the status line.
