@@ -62,7 +62,7 @@ void DetectionTable::build(const FrameObservations& frame, std::span<const ViewG
       int usable = 0;
       for (int k = 0; k < keypoints_; ++k) {
         const float* kp = &xyc[static_cast<std::size_t>(k) * 3];
-        usable += kp[2] > options.min_confidence && std::isfinite(kp[0]) && std::isfinite(kp[1]);
+        usable += usable_keypoint(kp[0], kp[1], kp[2], options.min_confidence);
       }
       if (usable < options.min_keypoints) {
         ++sparse_;
@@ -71,8 +71,7 @@ void DetectionTable::build(const FrameObservations& frame, std::span<const ViewG
       detections_.push_back({view, p, usable});
       for (int k = 0; k < keypoints_; ++k) {
         const float* kp = &xyc[static_cast<std::size_t>(k) * 3];
-        const bool ok =
-            kp[2] > options.min_confidence && std::isfinite(kp[0]) && std::isfinite(kp[1]);
+        const bool ok = usable_keypoint(kp[0], kp[1], kp[2], options.min_confidence);
         confidence_.push_back(ok ? kp[2] : 0.0f);
         rays_.push_back(ok ? glm::vec3(views[static_cast<std::size_t>(view)].ray(kp[0], kp[1]))
                            : glm::vec3(0.0f));

@@ -7,6 +7,8 @@
 // keypoints (Pose2Sim's TRC markers are BODY_25B keypoints) stay available in 3D.
 
 #include <array>
+#include <cmath>
+#include <limits>
 #include <span>
 #include <string_view>
 #include <vector>
@@ -15,6 +17,14 @@
 #include "core/keypoint_layout.hpp"
 
 namespace mocap::multiview {
+
+// Whether a keypoint (x, y, confidence) is there: a finite confidence above `min_confidence`
+// and finite coordinates within a million pixels (anything farther is garbage, not a pixel).
+inline bool usable_keypoint(float x, float y, float confidence, float min_confidence = 0.0f) {
+  constexpr float kFar = 1e6f;
+  return confidence > min_confidence && confidence < std::numeric_limits<float>::infinity() &&
+         std::abs(x) < kFar && std::abs(y) < kFar;
+}
 
 // The keypoints of the input and how the 15 body joints are made from them.
 struct KeypointSet {

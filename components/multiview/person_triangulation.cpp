@@ -5,6 +5,8 @@
 #include <limits>
 #include <stdexcept>
 
+#include "multiview/observations.hpp"
+
 namespace mocap::multiview {
 
 namespace {
@@ -91,7 +93,7 @@ float PersonTriangulator::triangulate(std::span<const ViewGeometry> views,
         double confidence2 = 0.0;
         int n = 0;
         for (const PointObservation& o : seen_) {
-          if (!(o.confidence > rule.min_confidence) || !std::isfinite(o.x)) continue;
+          if (!usable_keypoint(o.x, o.y, o.confidence, rule.min_confidence)) continue;
           confidence2 += static_cast<double>(o.confidence) * o.confidence;
           ++n;
         }

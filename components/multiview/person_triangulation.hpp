@@ -72,7 +72,7 @@ class PersonTriangulator {
   std::vector<float> residuals_;
   std::vector<float> table_;  // keypoints × sightings
   std::vector<float> gaps_;
-  float noise_m_ = 0.0f;      // median held-out residual of the person being triangulated
+  float noise_m_ = 0.0f;  // median held-out residual of the person being triangulated
 };
 
 }  // namespace mocap::multiview

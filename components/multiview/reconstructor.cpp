@@ -157,7 +157,7 @@ double MultiViewReconstructor::size_ratio(int group, const Sighting& sighting) c
   for (std::size_t k = 0; k < k_count; ++k) {
     const TriangulatedPoint& p = points_[static_cast<std::size_t>(group) * k_count + k];
     const float* kp = &sighting.xyc[3 * k];
-    if (!p.valid() || !(kp[2] > 0.0f) || !std::isfinite(kp[0]) || !std::isfinite(kp[1])) continue;
+    if (!p.valid() || !usable_keypoint(kp[0], kp[1], kp[2])) continue;
     const glm::dvec2 model = view.project(glm::dvec3(p.position));
     if (!std::isfinite(model.x)) continue;
     seen_sum += glm::dvec2(kp[0], kp[1]);
@@ -171,7 +171,7 @@ double MultiViewReconstructor::size_ratio(int group, const Sighting& sighting) c
   for (std::size_t k = 0; k < k_count; ++k) {
     const TriangulatedPoint& p = points_[static_cast<std::size_t>(group) * k_count + k];
     const float* kp = &sighting.xyc[3 * k];
-    if (!p.valid() || !(kp[2] > 0.0f) || !std::isfinite(kp[0]) || !std::isfinite(kp[1])) continue;
+    if (!p.valid() || !usable_keypoint(kp[0], kp[1], kp[2])) continue;
     const glm::dvec2 model = view.project(glm::dvec3(p.position));
     if (!std::isfinite(model.x)) continue;
     seen_spread +=

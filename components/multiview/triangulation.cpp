@@ -8,6 +8,8 @@
 
 #include <glm/geometric.hpp>
 
+#include "multiview/observations.hpp"
+
 namespace mocap::multiview {
 
 namespace {
@@ -15,7 +17,7 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 bool usable(const PointObservation& o, float min_confidence, std::size_t views) {
-  return o.confidence > min_confidence && std::isfinite(o.x) && std::isfinite(o.y) && o.view >= 0 &&
+  return usable_keypoint(o.x, o.y, o.confidence, min_confidence) && o.view >= 0 &&
          static_cast<std::size_t>(o.view) < views;
 }
 

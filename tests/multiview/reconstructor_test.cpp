@@ -3,6 +3,9 @@
 // regression would break. The bounds sit above what the method gives today (the numbers are in
 // docs/multiview.md), with room for the randomness of the scene, not for a broken method.
 
+#include <cmath>
+#include <limits>
+#include <random>
 #include <set>
 
 #include <gtest/gtest.h>
@@ -178,6 +181,62 @@ TEST(MultiViewScene, OursBeatsPose2SimRule) {
   EXPECT_EQ(theirs.score.wrong_associations, 0);
   EXPECT_LT(ours.score.mpjpe_mm(), 0.9 * theirs.score.mpjpe_mm());
   EXPECT_GT(ours.score.joints, theirs.score.joints);
+}
+
+}  // namespace
+}  // namespace mocap::test
+
+namespace mocap::test {
+namespace {
+
+// Keypoints from the network or a broken detector: NaN, infinities, huge and negative values,
+// people of one pixel, the same person twice in a view. Nothing throws, nothing non-finite comes
+// out.
+TEST(MultiViewGarbage, AnyKeypointValuesAreSurvived) {
+  const auto rig = scene_rig(4);
+  multiview::MultiViewReconstructor reconstructor(geometries(rig),
+                                                  multiview::KeypointSet::body15());
+  std::mt19937 rng(11);
+  const float specials[] = {std::numeric_limits<float>::quiet_NaN(),
+                            std::numeric_limits<float>::infinity(),
+                            -std::numeric_limits<float>::infinity(),
+                            1e30f,
+                            -1e30f,
+                            0.0f,
+                            -1.0f,
+                            5e5f};
+  std::uniform_real_distribution<float> pixel(-100.0f, 2000.0f), unit(0.0f, 1.0f);
+  multiview::FrameObservations frame;
+  for (int f = 0; f < 60; ++f) {
+    frame.reset(4, kBodyJoints);
+    for (int v = 0; v < 4; ++v) {
+      const int people = static_cast<int>(unit(rng) * 6);
+      for (int p = 0; p < people; ++p) {
+        const std::span<float> xyc = frame.add_person(v);
+        const float x0 = pixel(rng), y0 = pixel(rng);
+        for (std::size_t i = 0; i < xyc.size(); ++i) {
+          const float u = unit(rng);
+          xyc[i] = u < 0.1f   ? specials[static_cast<int>(unit(rng) * 8) % 8]
+                   : u < 0.3f ? (i % 3 == 0 ? x0 : y0)  // a person of one pixel
+                              : pixel(rng);
+        }
+        if (p == 1) frame.add_person(v, xyc);  // the same detection twice
+      }
+    }
+    const multiview::FrameResult& r = reconstructor.process(frame, f);
+    for (std::size_t p = 0; p < r.people.size(); ++p) {
+      for (const auto& k : r.keypoints_of(p)) {
+        if (!k.valid()) continue;
+        EXPECT_TRUE(std::isfinite(k.position.x) && std::isfinite(k.position.y) &&
+                    std::isfinite(k.position.z));
+      }
+    }
+  }
+  // Wrong shapes are refused with a message.
+  multiview::FrameObservations wrong(3, kBodyJoints);
+  EXPECT_THROW(reconstructor.process(wrong, 60), std::invalid_argument);
+  multiview::FrameObservations other_layout(4, 25);
+  EXPECT_THROW(reconstructor.process(other_layout, 60), std::invalid_argument);
 }
 
 }  // namespace
