@@ -5,6 +5,7 @@
 // by a capture volume); and our implementation of Pose2Sim's rule reproducing its TRC.
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <iomanip>
 #include <iostream>
@@ -121,7 +122,30 @@ struct MarkerStats {
   std::vector<float> distance_m, views, error_px;
 };
 
+// The eight limb bones between TRC markers (BODY_25B keypoints of the same names).
+const std::array<std::array<const char*, 2>, 8> kLimbs = {{{"RHip", "RKnee"},
+                                                           {"RKnee", "RAnkle"},
+                                                           {"LHip", "LKnee"},
+                                                           {"LKnee", "LAnkle"},
+                                                           {"RShoulder", "RElbow"},
+                                                           {"RElbow", "RWrist"},
+                                                           {"LShoulder", "LElbow"},
+                                                           {"LElbow", "LWrist"}}};
+
+// Mean over the limbs of the standard deviation of their length over the trial (metres).
+float limb_std(const std::vector<std::vector<float>>& lengths) {
+  double sum = 0.0;
+  for (const auto& l : lengths) {
+    const float m = mean(l);
+    double var = 0.0;
+    for (const float x : l) var += (x - m) * (x - m);
+    sum += std::sqrt(var / static_cast<double>(std::max<std::size_t>(l.size(), 1)));
+  }
+  return static_cast<float>(sum / static_cast<double>(lengths.size()));
+}
+
 struct DemoRun {
+  std::vector<std::vector<float>> limb_lengths = std::vector<std::vector<float>>(kLimbs.size());
   std::vector<MarkerStats> markers;
   std::vector<float> all_m;
   int frames_with_participant = 0;
@@ -167,6 +191,12 @@ DemoRun run(const Demo& demo, const multiview::ReconstructionOptions& options) {
       out.bystanders_in_participant += bystander(demo, c, i, detections[c]);
     }
     const auto keypoints = r.keypoints_of(static_cast<std::size_t>(participant));
+    for (std::size_t l = 0; l < kLimbs.size(); ++l) {
+      const auto& a = keypoints[body25b_keypoint(kLimbs[l][0])];
+      const auto& b = keypoints[body25b_keypoint(kLimbs[l][1])];
+      if (a.valid() && b.valid())
+        out.limb_lengths[l].push_back(glm::distance(a.position, b.position));
+    }
     for (std::size_t m = 0; m < demo.trc.markers.size(); ++m) {
       const int k = body25b_keypoint(demo.trc.markers[m]);
       if (k < 0 || !keypoints[k].valid()) continue;
@@ -203,11 +233,23 @@ std::string table(const Demo& demo, const DemoRun& ours, const DemoRun& no_prior
     px_ours.insert(px_ours.end(), a.error_px.begin(), a.error_px.end());
     px_rule.insert(px_rule.end(), b.error_px.begin(), b.error_px.end());
   }
+  std::vector<std::vector<float>> trc_limbs(kLimbs.size());
+  for (const auto& frame : demo.trc.frames) {
+    for (std::size_t l = 0; l < kLimbs.size(); ++l) {
+      trc_limbs[l].push_back(glm::distance(frame[*demo.trc.marker(kLimbs[l][0])],
+                                           frame[*demo.trc.marker(kLimbs[l][1])]));
+    }
+  }
   s << "| all | " << 1000 * median(ours.all_m) << " | " << 1000 * mean(ours.all_m) << " | "
     << 1000 * median(no_prior.all_m) << " | " << 1000 * mean(no_prior.all_m) << " | "
     << std::setprecision(2) << mean(views_ours) << " | " << mean(views_rule) << " | "
     << std::setprecision(1) << mean(px_ours) << " | " << mean(px_rule) << " | "
     << 1000 * median(rule.all_m) << " |\n";
+  s << "\nlimb length std over the trial (mean of 8 limbs), mm: ours "
+    << 1000 * limb_std(ours.limb_lengths) << ", ours without the prior "
+    << 1000 * limb_std(no_prior.limb_lengths) << ", Pose2Sim's rule "
+    << 1000 * limb_std(rule.limb_lengths) << ", Pose2Sim's TRC " << 1000 * limb_std(trc_limbs)
+    << "\n";
   return s.str();
 }
 
@@ -223,7 +265,11 @@ TEST(Pose2SimDemo, ParticipantWhereItsTrcIsBystandersKeptApart) {
   multiview::ReconstructionOptions rule_options;
   rule_options.triangulation.method = multiview::TriangulationMethod::pose2sim;
   const DemoRun rule = run(demo, rule_options);
-  std::cout << table(demo, ours, no_prior, rule);
+  std::cout << table(demo, ours, no_prior, rule)
+            << "frames with the participant: " << ours.frames_with_participant
+            << ", other people reported: " << ours.other_people
+            << ", bystander detections reported single-view: " << ours.bystander_single_view
+            << "\n";
 
   // The participant every frame (the first two frames confirm the track), never with a
   // bystander's detection.

@@ -96,14 +96,17 @@ std::vector<eval::ScenePerson> place_people(const std::vector<eval::TruthSequenc
   return people;
 }
 
-Scene render(const std::vector<eval::ScenePerson>& people, int views, int frames) {
+// `views` cameras of a ring of max(views, 4): two are 90 degrees apart, as a two-camera rig is set
+// up (opposite cameras see depth along their axis poorly).
+Scene render(const std::vector<eval::ScenePerson>& people, int views, int frames, float noise) {
   Scene s;
   s.views = views;
-  const auto rig = eval::ring_rig(views, 6.0, 1.6, 0.9, {0.0, 1.0, 0.0}, eval::Image{});
+  auto rig = eval::ring_rig(std::max(views, 4), 6.0, 1.6, 0.9, {0.0, 1.0, 0.0}, eval::Image{});
+  rig.resize(static_cast<std::size_t>(views));
   for (const auto& c : rig) s.geometry.push_back(c.geometry());
   eval::SceneRenderer renderer(rig, 1);
   eval::SceneDegradation d;
-  d.noise = 0.02f;
+  d.noise = noise;
   d.dropout = 0.10f;
   d.outliers = 0.05f;
   d.false_detections = 0.2f;
@@ -138,6 +141,81 @@ Pass run(const Scene& scene, const Variant& variant, int people, double budget_s
           scorer.score()};
 }
 
+// `--set NAME=VALUE`: a parameter of the reconstruction, for sweeps.
+void set_option(multiview::ReconstructionOptions& o, const std::string& assignment) {
+  const auto eq = assignment.find('=');
+  if (eq == std::string::npos) throw InputError("--set " + assignment, "expected NAME=VALUE");
+  const std::string name = assignment.substr(0, eq);
+  const float value = std::stof(assignment.substr(eq + 1));
+  const std::map<std::string, float*> fields = {
+      {"pair_gate_m", &o.pair_gate_m},
+      {"member_gate_m", &o.member_gate_m},
+      {"attach_gate_m", &o.attach_gate_m},
+      {"size_tolerance", &o.size_tolerance},
+      {"min_view_fraction", &o.min_view_fraction},
+      {"occlusion_margin_m", &o.occlusion_margin_m},
+      {"outlier_m", &o.triangulation.robust.outlier_m},
+      {"noise_factor", &o.triangulation.noise_factor},
+      {"noise_ceiling_m", &o.triangulation.noise_ceiling_m},
+      {"keep_pair", &o.rays.keep_pair},
+      {"keep_point", &o.rays.keep_point},
+      {"cap_m", &o.rays.cap_m},
+      {"gate_m", &o.tracker.gate_m},
+      {"velocity_smoothing", &o.tracker.velocity_smoothing},
+      {"sigma_learning", &o.tracker.sigma_learning},
+  };
+  if (name == "prior") {
+    o.tracker.prior = value != 0.0f;
+  } else if (name == "pair_search_views") {
+    o.triangulation.robust.pair_search_views = static_cast<int>(value);
+  } else if (const auto it = fields.find(name); it != fields.end()) {
+    *it->second = value;
+  } else {
+    throw InputError("--set " + assignment, "unknown parameter " + name);
+  }
+}
+
+std::vector<Variant> variants(const std::vector<std::string>& settings) {
+  std::vector<Variant> v(3);
+  v[0].name = "ours (association + robust triangulation + tracking)";
+  v[1].name = "ours without tracking (cold association every frame)";
+  v[1].options.tracking = false;
+  v[2].name = "baseline: Pose2Sim's rule (+ our association and tracking)";
+  v[2].options.triangulation.method = multiview::TriangulationMethod::pose2sim;
+  for (Variant& variant : v) {
+    for (const std::string& s : settings) set_option(variant.options, s);
+  }
+  return v;
+}
+
+// Accuracy per camera count and 2D noise, the other degradations at the target condition.
+void quality(const std::vector<eval::ScenePerson>& people, const std::vector<int>& view_counts,
+             const std::vector<float>& noises, int frames, const std::vector<Variant>& configs) {
+  std::cout << "## Multi-view accuracy on virtual scenes of CMU train clips\n\n"
+            << people.size() << " people, " << frames
+            << " frames at 30 fps, 10 % joints dropped, 5 % outlier keypoints, false "
+               "detections, occlusion; 1920x1080 cameras on a 6 m ring (2 and 3 cameras: "
+               "90 degrees apart)\n\n"
+            << "| views | σ | configuration | MPJPE mm | joints per person | wrong associations "
+               "| id switches | coverage | single-view detections |\n"
+            << "|---:|---:|---|---:|---:|---:|---:|---:|---:|\n";
+  for (const int views : view_counts) {
+    for (const float noise : noises) {
+      const Scene scene = render(people, views, frames, noise);
+      for (const Variant& v : configs) {
+        const eval::SceneScore s = run(scene, v, static_cast<int>(people.size()), 1e9).score;
+        std::cout << "| " << views << " | " << std::setprecision(0) << std::fixed << 100 * noise
+                  << " % | " << v.name << " | " << std::setprecision(1) << s.mpjpe_mm() << " | "
+                  << std::setprecision(2)
+                  << (s.reconstructed > 0 ? static_cast<double>(s.joints) / s.reconstructed : 0.0)
+                  << " | " << s.wrong_associations << " / " << s.person_frames << " | "
+                  << s.id_switches << " | " << std::setprecision(3) << s.coverage() << " | "
+                  << s.single_view << " |\n";
+      }
+    }
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -145,31 +223,48 @@ int main(int argc, char** argv) {
                  "Frame sets per second of association + triangulation + tracking on one core.");
   args.option("mocap", "DIR", "cmu31 folder with splits.txt", "../shared/data/mocap/cmu31")
       .option("people", "N", "people in the scene", "6")
-      .option("views", "N", "camera counts to run (repeat the option)", std::nullopt, true)
+      .option("views", "N",
+              "camera counts to run (repeat the option; default 4 and 16, with "
+              "--quality 2 3 4 6 8 16)",
+              std::nullopt, true)
       .option("frames", "N", "frame sets per scene (30 fps)", "300")
       .option("repeats", "N", "interleaved passes; medians are reported", "5")
-      .option("budget", "S", "CPU seconds at most per pass and variant", "3");
+      .option("budget", "S", "CPU seconds at most per pass and variant", "3")
+      .flag("quality", "accuracy per camera count and 2D noise instead of speed")
+      .option("noise", "S",
+              "with --quality: 2D noise σ as a fraction of the box height (repeat the "
+              "option; default 0, 0.01, 0.02, 0.05)",
+              std::nullopt, true)
+      .option("set", "NAME=VALUE",
+              "a reconstruction parameter for every configuration (repeatable): pair_gate_m, "
+              "member_gate_m, attach_gate_m, size_tolerance, min_view_fraction, "
+              "occlusion_margin_m, outlier_m, noise_factor, noise_ceiling_m, keep_pair, "
+              "keep_point, cap_m, gate_m, velocity_smoothing, sigma_learning, prior (0/1), "
+              "pair_search_views",
+              std::nullopt, true);
   int code = 0;
   if (!args.parse(argc - 1, argv + 1, code)) return code;
   try {
     const auto clips = load_clips(args.get("mocap"));
     const int people = static_cast<int>(args.integer("people"));
-    const auto placed = place_people(clips, people, static_cast<int>(args.integer("frames")));
+    const int frame_count = static_cast<int>(args.integer("frames"));
+    const auto placed = place_people(clips, people, frame_count);
     std::vector<int> view_counts;
     for (const std::string& v : args.all("views")) view_counts.push_back(std::stoi(v));
+    const std::vector<Variant> configs = variants(args.all("set"));
+    if (args.has("quality")) {
+      if (view_counts.empty()) view_counts = {2, 3, 4, 6, 8, 16};
+      std::vector<float> noises;
+      for (const std::string& n : args.all("noise")) noises.push_back(std::stof(n));
+      if (noises.empty()) noises = {0.0f, 0.01f, 0.02f, 0.05f};
+      quality(placed, view_counts, noises, frame_count, configs);
+      return 0;
+    }
     if (view_counts.empty()) view_counts = {4, 16};
-
-    std::vector<Variant> variants(3);
-    variants[0].name = "ours (association + robust triangulation + tracking)";
-    variants[1].name = "ours without tracking (cold association every frame)";
-    variants[1].options.tracking = false;
-    variants[2].name = "baseline: Pose2Sim's rule (+ our association and tracking)";
-    variants[2].options.triangulation.method = multiview::TriangulationMethod::pose2sim;
+    const std::vector<Variant>& variants = configs;
 
     std::vector<Scene> scenes;
-    for (const int v : view_counts) {
-      scenes.push_back(render(placed, v, static_cast<int>(args.integer("frames"))));
-    }
+    for (const int v : view_counts) scenes.push_back(render(placed, v, frame_count, 0.02f));
     std::map<std::pair<std::size_t, std::size_t>, std::vector<double>> rates, wall_rates;
     std::map<std::pair<std::size_t, std::size_t>, Pass> last;
     for (long pass = 0; pass < args.integer("repeats"); ++pass) {
