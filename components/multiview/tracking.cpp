@@ -99,7 +99,7 @@ std::span<const float> Tracker::prediction_sigma(int t) const {
 float Tracker::gate(int t) const {
   const auto missed =
       static_cast<float>(std::max<std::int64_t>(frame_ - track(t).last_frame - 1, 0));
-  return options_.gate_m + options_.gate_growth_m * missed;
+  return std::min(options_.max_gate_m, options_.gate_m + options_.gate_growth_m * missed);
 }
 
 void Tracker::start(int t, const TrackInput& person) {

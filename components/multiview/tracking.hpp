@@ -37,9 +37,13 @@ namespace mocap::multiview {
 struct TrackingOptions {
   double fps = 30.0;  // frame numbers to seconds
   // Largest detection-to-prediction cost (metres, detections.hpp) for a track's detection in a
-  // view, one frame after its last sighting; grows by gate_growth_m per further frame.
+  // view, one frame after its last sighting; grows by gate_growth_m per further frame up to
+  // max_gate_m. (Costs are capped at RayCostOptions::cap_m: a gate that high would let a track
+  // lost for seconds take any detection; a person back after a while is recognised by
+  // place_new's reach and bones instead.)
   float gate_m = 0.25f;
   float gate_growth_m = 0.02f;
+  float max_gate_m = 0.4f;
   // Weight of the newest velocity measurement (1: no smoothing). 0.3 / 0.5 / 1 gave 29.7 / 30.7 /
   // 34.0 mm MPJPE on the virtual scenes (4 views, 3 people, σ 2 %; docs/multiview.md).
   float velocity_smoothing = 0.3f;
