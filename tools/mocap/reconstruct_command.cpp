@@ -179,8 +179,8 @@ std::string matcher_layout_offsets(const std::string& setting, const std::string
   return std::string(layout(first.layout).name);
 }
 
-// What --fit means: auto fits the whole sequence of a file (offline), with a fixed lag for a live
-// source, and not at all for keypoints whose camera is unknown (JSON without --image-size or
+// What --fit means: auto fits a file offline (full: overlapping windows), a live source with a
+// fixed lag, and not at all keypoints whose camera is unknown (JSON without --image-size or
 // --camera: nothing tells where the camera's rays go).
 std::string fit_mode(const Args& args, InputKind kind, bool live) {
   const std::string fit = args.get("fit");
@@ -433,8 +433,9 @@ int reconstruct_command(int argc, char** argv) {
               "lens distortion replace --image-size/--hfov for the ray through each root")
       .option("fit", "auto|off|live|full",
               "skeleton fitting (root translation, the person's bones, feet on the floor): full "
-              "over the whole sequence, live with a 3-frame lag; auto: full for files, live for "
-              "cameras and streams, off for OpenPose JSON without --image-size/--camera",
+              "in windows of 64 frames per person overlapping by 16 (written as each window is "
+              "solved), live with a 3-frame lag; auto: full for files, live for cameras and "
+              "streams, off for OpenPose JSON without --image-size/--camera",
               "auto")
       .option("ground", "auto|feet|off",
               "the floor for the fitting: auto takes the camera file's (`mocap calibrate "
