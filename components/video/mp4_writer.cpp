@@ -1,6 +1,12 @@
 #include "video/mp4_writer.hpp"
 
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
 #include <cmath>
+#include <cstring>
+#include <filesystem>
 #include <mutex>
 #include <stdexcept>
 
@@ -23,11 +29,70 @@ std::string av_error(int code) {
   return text;
 }
 
+// The muxer's output (format->pb is ours: AVFMT_FLAG_CUSTOM_IO, so it is never closed for us).
 struct FormatDeleter {
-  void operator()(AVFormatContext* f) const {
-    if (f->pb) avio_closep(&f->pb);
-    avformat_free_context(f);
+  void operator()(AVFormatContext* f) const { avformat_free_context(f); }
+};
+struct AvioDeleter {
+  void operator()(AVIOContext* io) const {
+    av_freep(&io->buffer);
+    avio_context_free(&io);
   }
+};
+
+// The file behind the muxer, created only once its first fragment is complete: until then the
+// header is held here, so a process killed before its first frame is on disk leaves no file
+// rather than one that holds no picture (nothing can play it). `position` runs on from the
+// header, as the muxer's offsets expect.
+class DeferredFile {
+ public:
+  explicit DeferredFile(std::string path) : path_(std::move(path)) {}
+  ~DeferredFile() {
+    if (fd_ >= 0) ::close(fd_);
+  }
+  DeferredFile(const DeferredFile&) = delete;
+  DeferredFile& operator=(const DeferredFile&) = delete;
+
+  // AVIOContext's write callback; an error is an AVERROR code the muxer keeps in pb->error.
+#if LIBAVFORMAT_VERSION_MAJOR >= 61
+  static int write_packet(void* self, const std::uint8_t* data, int size) {
+#else
+  static int write_packet(void* self, std::uint8_t* data, int size) {
+#endif
+    return static_cast<DeferredFile*>(self)->write(data, static_cast<std::size_t>(size));
+  }
+  // Creates the file with what was held back; 0 or an AVERROR code.
+  int create() {
+    if (fd_ >= 0) return 0;
+    fd_ = ::open(path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    if (fd_ < 0) return AVERROR(errno);
+    const int r = write_all(reinterpret_cast<const std::uint8_t*>(held_.data()), held_.size());
+    held_ = {};
+    return r;
+  }
+
+ private:
+  int write(const std::uint8_t* data, std::size_t size) {
+    if (fd_ < 0) {
+      held_.append(reinterpret_cast<const char*>(data), size);
+      return static_cast<int>(size);
+    }
+    const int r = write_all(data, size);
+    return r < 0 ? r : static_cast<int>(size);
+  }
+  int write_all(const std::uint8_t* data, std::size_t size) {
+    while (size > 0) {
+      const ssize_t n = ::write(fd_, data, size);
+      if (n < 0 && errno == EINTR) continue;
+      if (n < 0) return AVERROR(errno);
+      data += n;
+      size -= static_cast<std::size_t>(n);
+    }
+    return 0;
+  }
+  std::string path_;
+  std::string held_;
+  int fd_ = -1;
 };
 struct EncoderDeleter {
   void operator()(AVCodecContext* c) const { avcodec_free_context(&c); }
@@ -79,6 +144,8 @@ struct Mp4Writer::Impl {
   Mp4WriterOptions options;
   int width = 0, height = 0;              // the pictures' size
   int coded_width = 0, coded_height = 0;  // even
+  std::unique_ptr<DeferredFile> file;
+  std::unique_ptr<AVIOContext, AvioDeleter> output;  // writes to `file`
   std::unique_ptr<AVFormatContext, FormatDeleter> format;
   std::unique_ptr<AVCodecContext, EncoderDeleter> encoder;
   AVStream* stream = nullptr;
@@ -146,9 +213,19 @@ struct Mp4Writer::Impl {
     stream->avg_frame_rate = encoder->framerate;
     if (const int r = avcodec_parameters_from_context(stream->codecpar, encoder.get()); r < 0)
       fail("cannot describe the video stream", r);
-    // "file:" so that a path with a colon is never taken for another protocol.
-    if (const int r = avio_open(&format->pb, ("file:" + path).c_str(), AVIO_FLAG_WRITE); r < 0)
-      fail("cannot create the video file", r);
+    check_folder();
+    file = std::make_unique<DeferredFile>(path);
+    constexpr int kBufferBytes = 64 * 1024;
+    auto* buffer = static_cast<unsigned char*>(av_malloc(kBufferBytes));
+    if (!buffer) throw std::bad_alloc();
+    output.reset(avio_alloc_context(buffer, kBufferBytes, 1, file.get(), nullptr,
+                                    &DeferredFile::write_packet, nullptr));
+    if (!output) {
+      av_free(buffer);
+      throw std::bad_alloc();
+    }
+    format->pb = output.get();
+    format->flags |= AVFMT_FLAG_CUSTOM_IO;
     // Fragmented: the index (moov) first and empty, each frame a fragment (moof + mdat) flushed
     // by write() below; default_base_moof makes fragments self-contained (browsers want it).
     AVDictionary* muxer_options = nullptr;
@@ -156,7 +233,6 @@ struct Mp4Writer::Impl {
     const int r = avformat_write_header(format.get(), &muxer_options);
     av_dict_free(&muxer_options);
     if (r < 0) fail("cannot write the video's header", r);
-    flush();
     yuv.reset(av_frame_alloc());
     packet.reset(av_packet_alloc());
     if (!yuv || !packet) throw std::bad_alloc();
@@ -166,10 +242,23 @@ struct Mp4Writer::Impl {
     if (const int e = av_frame_get_buffer(yuv.get(), 0); e < 0) fail("cannot allocate a frame", e);
   }
 
-  // Everything the muxer holds goes to the operating system, which keeps it if the process dies.
+  // The file is made at the first frame; its folder must take it now, so a bad path fails here.
+  void check_folder() const {
+    namespace fs = std::filesystem;
+    const fs::path folder = fs::path(path).parent_path();
+    std::error_code ec;
+    if (!folder.empty() && !fs::is_directory(folder, ec))
+      fail("cannot create the video file: no folder " + folder.string());
+    if (::access(folder.empty() ? "." : folder.c_str(), W_OK | X_OK) != 0)
+      fail(std::string("cannot create the video file: ") + std::strerror(errno));
+  }
+
+  // Everything the muxer holds goes to the operating system, which keeps it if the process dies
+  // (the file made, with its header, when the first fragment is complete).
   void flush() {
     avio_flush(format->pb);
     if (format->pb->error < 0) fail("cannot write the video", format->pb->error);
+    if (const int r = file->create(); r < 0) fail("cannot create the video file", r);
   }
 
   // Writes every packet the encoder has ready, each as its own fragment.
@@ -214,7 +303,6 @@ struct Mp4Writer::Impl {
     drain();
     if (const int r = av_write_trailer(format.get()); r < 0) fail("cannot finish the video", r);
     flush();
-    if (const int r = avio_closep(&format->pb); r < 0) fail("cannot close the video", r);
   }
 };
 

@@ -35,10 +35,12 @@ bool h264_available();
 
 class Mp4Writer {
  public:
-  // Creates (or truncates) the file `path` for pictures of `width` x `height` (an odd size loses
-  // its last column or row: the encoders work on 2x2 blocks) and writes its header. Throws
-  // InputError naming the file when it cannot be created or written, std::invalid_argument for a
-  // size below 2 pixels or a frame rate that is not positive and finite.
+  // A video `path` for pictures of `width` x `height` (an odd size loses its last column or row:
+  // the encoders work on 2x2 blocks). The file is created (or truncated) when its first frame is
+  // encoded, with its header, so that it never exists without a picture to play; whether its
+  // folder takes it is checked here. Throws InputError naming the file when it cannot be created
+  // or written, std::invalid_argument for a size below 2 pixels or a frame rate that is not
+  // positive and finite.
   Mp4Writer(std::string path, int width, int height, Mp4WriterOptions options = {});
   // Finishes the file (close()) if that was not done; errors are swallowed here.
   ~Mp4Writer();

@@ -87,6 +87,22 @@ TEST(Mp4Writer, ClosedFileDecodesToEveryFrameInEachCodec) {
   }
 }
 
+// A process killed before its first frame was written leaves no file, rather than one that holds
+// a header and no picture: the file appears with its first frame, and plays from then on.
+TEST(Mp4Writer, TheFileAppearsWithItsFirstFrame) {
+  test::TempDir dir;
+  for (Mp4Codec codec : codecs()) {
+    const std::string path = dir.file(codec == Mp4Codec::h264 ? "h264.mp4" : "mpeg4.mp4");
+    Mp4Writer writer(path, 320, 180, {10.0, codec});
+    EXPECT_FALSE(fs::exists(path)) << "made before any frame";
+    writer.write(picture(0));
+    ASSERT_TRUE(fs::exists(path));
+    EXPECT_EQ(decoded_frames(path), 1) << path;
+    writer.write(picture(1));
+    EXPECT_GE(decoded_frames(path), 1) << path;
+  }
+}
+
 TEST(Mp4Writer, OddSizesLoseTheirLastColumnAndRowAnyPixelFormat) {
   test::TempDir dir;
   const std::string path = dir.file("odd.mp4");
