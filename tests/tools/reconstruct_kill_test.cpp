@@ -11,6 +11,7 @@
 
 #include <csignal>
 #include <thread>
+#include <utility>
 
 #include <nlohmann/json.hpp>
 #include <opencv2/videoio.hpp>
@@ -105,6 +106,12 @@ std::size_t expect_outputs_whole(const fs::path& out, bool killed, const std::st
   return lines_read;
 }
 
+// When each run is stopped: SIGINT as soon as it has started (nothing written: no summary either)
+// and once poses.jsonl holds 10 and 40 frames; SIGKILL at 10 and 40 (at the start it would only
+// repeat the SIGINT case without its summary).
+constexpr std::pair<int, std::size_t> kMoments[] = {
+    {SIGINT, 0}, {SIGINT, 10}, {SIGINT, 40}, {SIGKILL, 10}, {SIGKILL, 40}};
+
 class ReconstructKillTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
@@ -188,17 +195,15 @@ class ReconstructKillTest : public ::testing::Test {
 
 TEST_F(ReconstructKillTest, AnInterruptedOpenPoseRunKeepsWholeFiles) {
   const std::vector<std::string> camera = {"--image-size", "1920x1080", "--fps", "25"};
-  for (const int signal : {SIGINT, SIGKILL})
-    for (const std::size_t lines : {std::size_t{0}, std::size_t{10}, std::size_t{40}})
-      interrupt("json", dir_->file("json"), camera, kJsonFrames, signal, lines);
+  for (const auto& [signal, lines] : kMoments)
+    interrupt("json", dir_->file("json"), camera, kJsonFrames, signal, lines);
 }
 
 TEST_F(ReconstructKillTest, AnInterruptedVideoRunKeepsWholeFiles) {
   if (!fs::exists(kVideo)) GTEST_SKIP() << "shared video absent: " << kVideo;
   if (!model_present()) GTEST_SKIP() << "MoveNet model absent: tools/setup.sh --models-only";
-  for (const int signal : {SIGINT, SIGKILL})
-    for (const std::size_t lines : {std::size_t{0}, std::size_t{10}, std::size_t{40}})
-      interrupt("video", kVideo.string(), {}, 200, signal, lines);
+  for (const auto& [signal, lines] : kMoments)
+    interrupt("video", kVideo.string(), {}, 200, signal, lines);
 }
 
 // The overlay draws every input frame, whatever the fitting (off: as frames come; live: 3 frames
