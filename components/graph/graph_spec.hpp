@@ -34,7 +34,11 @@ std::optional<EdgePolicy> parse_policy(std::string_view text);
 
 struct PortRef {
   std::string node, port;
-  std::string str() const { return node + "." + port; }
+  int index = -1;  // edge index of a repeated input ("solve.view:2"); -1: none written
+
+  std::string str() const {
+    return node + "." + port + (index >= 0 ? ":" + std::to_string(index) : std::string());
+  }
 };
 
 // ZeroMQ CURVE of an edge (`curve: { server: keys/solve, client: keys/capture }`): key file
@@ -60,8 +64,10 @@ struct EdgeSpec {
 };
 
 struct ParamText {
-  std::string text;
+  std::string text;  // a single value, or a comma list (--set) for a list parameter
   SourceLocation where;
+  bool is_list = false;  // written as a YAML sequence: the items are in `items`
+  std::vector<std::string> items{};
 };
 
 struct NodeSpec {
