@@ -92,7 +92,7 @@ struct Harness::Impl final : public Context {
     sync_copy = sync->stats();
     for (std::size_t i = 0; i < slots.size(); ++i) {
       sync_copy.inputs[i].name =
-          slots[i].repeated ? slots[i].port + ":" + std::to_string(slots[i].index) : slots[i].port;
+          indexed_port(slots[i].port, slots[i].repeated ? static_cast<long>(slots[i].index) : -1);
     }
   }
   void close_once() {

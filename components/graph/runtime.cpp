@@ -361,7 +361,7 @@ void NodeRunner::publish_sync_stats(bool now) {
   sync_stats_ = sync->stats();
   for (std::size_t i = 0; i < slots.size(); ++i) {
     sync_stats_.inputs[i].name =
-        slots[i].repeated ? slots[i].port + ":" + std::to_string(slots[i].index) : slots[i].port;
+        indexed_port(slots[i].port, slots[i].repeated ? static_cast<long>(slots[i].index) : -1);
   }
 }
 

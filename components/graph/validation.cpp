@@ -216,7 +216,7 @@ class Checker {
           if (by_index[k]) continue;
           const EdgeSpec* after = *std::find_if(by_index.begin() + static_cast<std::ptrdiff_t>(k),
                                                 by_index.end(), [](auto* e) { return e; });
-          error(after->where, "input " + name + ":" + std::to_string(k) +
+          error(after->where, "input " + indexed_port(name, static_cast<long>(k)) +
                                   " is not connected, but " + after->to.str() +
                                   " is (number the edges of " + name + " 0.." +
                                   std::to_string(node.input_counts[i] - 1) + " without gaps)");
@@ -586,8 +586,7 @@ std::string to_dot(const ResolvedGraph& graph) {
   for (const EdgeSpec& e : graph.spec.edges) {
     const ResolvedNode* from = graph.find(e.from.node);
     const auto port = static_cast<std::size_t>(from->type->contract.output_index(e.from.port));
-    const std::string to_port =
-        e.to.port + (e.to.index >= 0 ? ":" + std::to_string(e.to.index) : std::string());
+    const std::string to_port = indexed_port(e.to.port, e.to.index);
     out << "  \"" << e.from.node << "\" -> \"" << e.to.node << "\" [label=\"" << e.from.port
         << " -> " << to_port << "\\n"
         << from->output_types[port] << ", " << e.policy.str()
