@@ -330,8 +330,7 @@ void NodeRunner::run_source() {
 
 void NodeRunner::run_consumer() {
   while (inputs_.next(true) == NodeInputs::Step::call) {
-    const std::size_t messages = inputs_.received();
-    in_ = messages;
+    in_ = inputs_.received();
     // A stop bounds the drain: once its deadline has passed, what is still queued is counted
     // (a drop, and a log line at the end) instead of processed, so the graph exits in time.
     if (runtime_.abandon_queued()) {
@@ -345,6 +344,7 @@ void NodeRunner::run_consumer() {
     timed_process();
     publish_sync_stats(false);
   }
+  in_ = inputs_.received();
   publish_sync_stats(true);
 }
 
