@@ -1,6 +1,7 @@
-// sink.overlay in a graph: a playable MP4 with one picture per frame that had both inputs, PNG
-// snapshots, the optional video input under the 2D people or the frames read again from the file
-// (video_path), and errors naming the file.
+// sink.overlay: in a graph, a playable MP4 with one picture per frame that had both inputs and PNG
+// snapshots, the frames read again from the file (video_path), a killed run's video that plays;
+// alone in the test harness, every frame drawn however far (within the bound) the 3D lags its 2D,
+// nothing hung beyond it, the optional video input under the 2D people, and errors naming the file.
 
 #include <signal.h>
 #include <sys/wait.h>
@@ -14,6 +15,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
 
+#include "graph/harness.hpp"
 #include "sink_test_util.hpp"
 #include "support/small_pose_database.hpp"
 #include "video/mp4_writer.hpp"
@@ -50,7 +52,7 @@ TEST(OverlaySink, WritesAPlayableMp4AndPngsOfEveryJoinedFrame) {
       run_graph(R"(
 nodes:
   src: { type: unit.people_script, params: { db: )" +
-                db + ", script: \"" + two_people_script(30) + R"(", skip_2d: "7" } }
+                db + ", script: \"" + two_people_script(30) + R"(", skip_2d: [7] } }
   overlay: { type: sink.overlay, params: { video: )" +
                 mp4 + ", png_every: 10, png_dir: " + dir.file("png") +
                 R"(, panel_height: 240 } }
@@ -73,22 +75,103 @@ edges:
   EXPECT_TRUE(std::filesystem::exists(dir.file("png/overlay_000011.png")));  // after the drop
 }
 
-// The video input, when connected and waited for, is drawn under the 2D people (it is red).
-TEST(OverlaySink, VideoFramesAreDrawnUnderThe2DPeople) {
-  MOCAP_REQUIRE_SMALL_DATABASE(db);
+// --- alone in the test harness (graph/harness.hpp): no pose database needed
+
+// A person standing at the canvas centre (COCO-17, pixels) and the same body in 3D (metres).
+People2D people2d(std::int64_t frame) {
+  People2D m;
+  m.header = {"cam", static_cast<std::uint64_t>(frame), frame * 33'000'000, frame};
+  Person2D p;
+  p.id = 1;
+  for (int j = 0; j < 17; ++j) {
+    p.joints.push_back({960.0f + 10.0f * static_cast<float>(j % 3), 300.0f + 25.0f * j, 0.9f});
+  }
+  p.box = {900, 280, 120, 440};
+  m.people.push_back(p);
+  return m;
+}
+
+People3D people3d(std::int64_t frame) {
+  People3D m;
+  m.header = {"cam", static_cast<std::uint64_t>(frame), frame * 33'000'000, frame};
+  Person3D p;
+  p.id = 1;
+  for (int j = 0; j < kBodyJoints; ++j) {
+    p.positions[static_cast<std::size_t>(j)] = {0.05f * static_cast<float>(j % 3), -0.8f + 0.1f * j,
+                                                0.0f};
+  }
+  m.people.push_back(p);
+  return m;
+}
+
+// The order a graph delivers them in when the 3D lags `lag` frames behind the 2D (the offline
+// fit's windows): the 2D of frame f, then the 3D of frame f - lag.
+void push_lagging(graph::Harness& overlay, int frames, int lag) {
+  for (int f = 0; f < frames + lag; ++f) {
+    if (f < frames) overlay.push("people2d", people2d(f));
+    if (f >= lag) overlay.push("people3d", people3d(f - lag));
+    overlay.process_ready();
+  }
+}
+
+graph::HarnessOptions one_source() {
+  graph::HarnessOptions options;
+  options.unconnected = {"video"};
+  options.at_bound =
+      graph::AtBound::pass_partial;  // the runtime's choice: 2D and 3D share a source
+  return options;
+}
+
+// 150 frames whose 3D comes 120 frames after their 2D: all drawn (the old joining kept 64).
+TEST(OverlaySink, EveryFrameIsDrawnWhenThe3DLagsWithinTheBound) {
   test::TempDir dir;
-  const graph::RunResult result = run_graph(R"(
-nodes:
-  src: { type: unit.people_script, params: { db: )" +
-                                            db + ", script: \"" + two_people_script(3) + R"(" } }
-  overlay: { type: sink.overlay, params: { png_every: 1, png_dir: )" +
-                                            dir.file("png") + R"(, wait_for_video: true } }
-edges:
-  - [src.people2d, overlay.people2d]
-  - [src.people3d, overlay.people3d]
-  - [src.video, overlay.video]
-)");
-  ASSERT_TRUE(result.ok) << result.error;
+  const std::string mp4 = dir.file("overlay.mp4");
+  graph::Harness overlay("sink.overlay", {{"video", mp4}, {"panel_height", "96"}}, one_source());
+  push_lagging(overlay, 150, 120);
+  overlay.finish();
+  const graph::NodeStats stats = overlay.stats();
+  EXPECT_EQ(stats.sync.complete, 150u);
+  EXPECT_EQ(stats.drops, 0u);
+  EXPECT_GE(stats.sync.inputs[0].max_held, 120u);
+  cv::Size size;
+  EXPECT_EQ(count_video_frames(mp4, size), 150);
+}
+
+// Beyond the bound nothing hangs: the frames past it go on partial, their 3D comes late, and the
+// overlay counts each as a drop; the others are drawn.
+TEST(OverlaySink, ALagBeyondTheBoundIsCountedNotHung) {
+  test::TempDir dir;
+  const std::string mp4 = dir.file("overlay.mp4");
+  graph::Harness overlay(
+      "sink.overlay", {{"video", mp4}, {"panel_height", "96"}, {"sync_bound", "50"}}, one_source());
+  push_lagging(overlay, 150, 120);
+  overlay.finish();
+  const graph::NodeStats stats = overlay.stats();
+  const std::uint64_t late = stats.sync.inputs[1].late;
+  EXPECT_GT(late, 0u);
+  EXPECT_EQ(stats.sync.inputs[1].missing, late);
+  EXPECT_EQ(stats.sync.complete + late, 150u);
+  EXPECT_EQ(stats.drops, 2 * late);  // the 2D alone, then its 3D alone
+  cv::Size size;
+  EXPECT_EQ(count_video_frames(mp4, size), static_cast<int>(stats.sync.complete));
+}
+
+// The video input, when connected, is drawn under the 2D people.
+TEST(OverlaySink, VideoFramesAreDrawnUnderThe2DPeople) {
+  test::TempDir dir;
+  graph::Harness overlay("sink.overlay", {{"png_every", "1"}, {"png_dir", dir.file("png")}});
+  for (int f = 0; f < 3; ++f) {
+    VideoFrame video;
+    video.header = people2d(f).header;
+    video.image = ImageBuffer(320, 180, PixelFormat::bgr8);
+    const auto pixels = video.image.pixels_for_writing();
+    for (std::size_t i = 2; i < pixels.size(); i += 3) pixels[i] = std::byte{200};  // red (BGR)
+    overlay.push("video", std::move(video));
+    overlay.push("people2d", people2d(f));
+    overlay.push("people3d", people3d(f));
+  }
+  overlay.finish();
+  EXPECT_EQ(overlay.stats().sync.complete, 3u);
   const cv::Mat picture = cv::imread(dir.file("png/overlay_000002.png"));
   ASSERT_FALSE(picture.empty());
   // The 320 x 180 video fills the left panel (854 x 480 for 16:9); a corner pixel away from the
@@ -186,38 +269,31 @@ edges:
   }
 }
 
-TEST(OverlaySink, UnwritableVideoFailsTheGraphNamingTheFile) {
-  MOCAP_REQUIRE_SMALL_DATABASE(db);
+TEST(OverlaySink, UnwritableVideoFailsNamingTheFile) {
   test::TempDir dir;
   std::filesystem::create_directories(dir.file("taken.mp4"));  // a folder where the file goes
   const std::string mp4 = dir.file("taken.mp4");
-  const graph::RunResult result = run_graph(R"(
-nodes:
-  src: { type: unit.people_script, params: { db: )" +
-                                            db + ", script: \"" + two_people_script(2) + R"(" } }
-  overlay: { type: sink.overlay, params: { video: )" +
-                                            mp4 + R"( } }
-edges:
-  - [src.people2d, overlay.people2d]
-  - [src.people3d, overlay.people3d]
-)");
-  EXPECT_FALSE(result.ok);
-  EXPECT_NE(result.error.find(mp4), std::string::npos) << result.error;
+  graph::HarnessOptions options;
+  options.unconnected = {"video"};
+  graph::Harness overlay("sink.overlay", {{"video", mp4}}, options);
+  try {
+    overlay.push("people2d", people2d(0));
+    overlay.push("people3d", people3d(0));
+    overlay.finish();
+    FAIL() << "writing into a folder worked";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find(mp4), std::string::npos) << e.what();
+  }
 }
 
 TEST(OverlaySink, NothingToWriteIsRefusedAtOpen) {
-  MOCAP_REQUIRE_SMALL_DATABASE(db);
-  const graph::RunResult result = run_graph(R"(
-nodes:
-  src: { type: unit.people_script, params: { db: )" +
-                                            db + R"(, script: "0:0:0:0" } }
-  overlay: { type: sink.overlay }
-edges:
-  - [src.people2d, overlay.people2d]
-  - [src.people3d, overlay.people3d]
-)");
-  EXPECT_FALSE(result.ok);
-  EXPECT_NE(result.error.find("nothing to write"), std::string::npos) << result.error;
+  graph::Harness overlay("sink.overlay");
+  try {
+    overlay.open();
+    FAIL() << "an overlay writing nothing opened";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("nothing to write"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

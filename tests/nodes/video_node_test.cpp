@@ -10,6 +10,8 @@
 #include <mutex>
 #include <vector>
 
+#include "core/input_error.hpp"
+#include "graph/harness.hpp"
 #include "graph/registry.hpp"
 #include "graph/transport.hpp"
 #include "sink_test_util.hpp"
@@ -63,21 +65,37 @@ std::string graph_yaml(const std::string& source_params, const std::string& edge
          std::to_string(delay_ms) + " } }\nedges:\n  - [src.frames, out.in" + edge + "]\n";
 }
 
+// Alone in the test harness (graph/harness.hpp): run the source a few calls at a time and pull
+// what it sent, so only a few decoded frames are held at once.
 TEST(VideoSourceNode, OfflineSendsEveryFrameStampedWithItsTimeInTheVideo) {
   if (!fs::exists(kVtestPart)) GTEST_SKIP() << "shared video absent: " << kVtestPart;
-  seen.clear();
-  const RunResult result =
-      testing::run_graph(graph_yaml("path: " + kVtestPart + ", mode: offline"));
-  ASSERT_TRUE(result.ok) << result.error;
-  ASSERT_EQ(seen.size(), 200u);
-  for (std::size_t i = 0; i < seen.size(); ++i) {
-    EXPECT_EQ(seen[i].header.seq, i);
-    EXPECT_EQ(seen[i].header.frame, static_cast<std::int64_t>(i));
-    EXPECT_NEAR(static_cast<double>(seen[i].header.capture_ns) * 1e-9, 0.1 * i, 0.011);
-    EXPECT_EQ(seen[i].width, 768);
-    EXPECT_EQ(seen[i].height, 576);
+  Harness src("source.video", {{"path", kVtestPart}, {"mode", "offline"}});
+  std::size_t count = 0;
+  while (!src.ended("frames") && count < 1000) {
+    src.run_source(20);
+    for (const auto& frame : src.pull<VideoFrame>("frames")) {
+      EXPECT_EQ(frame->header.seq, count);
+      EXPECT_EQ(frame->header.frame, static_cast<std::int64_t>(count));
+      EXPECT_NEAR(static_cast<double>(frame->header.capture_ns) * 1e-9, 0.1 * count, 0.011);
+      EXPECT_EQ(frame->image.width(), 768);
+      EXPECT_EQ(frame->image.height(), 576);
+      ++count;
+    }
   }
-  EXPECT_EQ(testing::stats_of(result, "src").drops, 0u);
+  EXPECT_EQ(count, 200u);
+  EXPECT_EQ(src.stats().drops, 0u);
+}
+
+TEST(VideoSourceNode, AModeThatIsNoChoiceIsRefusedBeforeOpening) {
+  try {
+    Harness src("source.video", {{"path", kVtestPart}, {"mode", "Live"}});
+    FAIL() << "mode Live was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("'Live' is not one of offline, live, auto; did you "
+                                         "mean 'live'?"),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 TEST(VideoSourceNode, LiveReplaysAFileAtItsRateWithWallClockCaptureTimes) {
@@ -223,11 +241,17 @@ TEST(VideoSourceNode, AnAbsentCameraStopsTheGraphWithAClearError) {
   EXPECT_NE(result.error.find("no such camera device"), std::string::npos) << result.error;
 }
 
-TEST(VideoSourceNode, RefusesAnUnknownMode) {
-  if (!fs::exists(kVtestPart)) GTEST_SKIP() << "shared video absent: " << kVtestPart;
-  const RunResult result = testing::run_graph(graph_yaml("path: " + kVtestPart + ", mode: fast"));
-  ASSERT_FALSE(result.ok);
-  EXPECT_NE(result.error.find("offline, live or auto"), std::string::npos) << result.error;
+// A mode is a choice: graph validation refuses an unknown one, before any node runs.
+TEST(VideoSourceNode, RefusesAnUnknownModeWhenTheGraphIsValidated) {
+  try {
+    testing::run_graph(graph_yaml("path: " + kVtestPart + ", mode: fast"));
+    FAIL() << "mode fast was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("test.yaml:2: node 'src': parameter 'mode': 'fast' is "
+                                         "not one of offline, live, auto"),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 }  // namespace

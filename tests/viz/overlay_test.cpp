@@ -1,6 +1,6 @@
 // The overlay renderer draws each person in their colour where they belong (2D on the left, 3D on
-// the right: placed where the fitting put them, or in a row), the 3D view frames and follows them,
-// and the input joiner pairs messages by frame and counts what it must drop.
+// the right: placed where the fitting put them, or in a row), the 3D view frames and follows them.
+// Joining its inputs by frame is the framework's (tests/graph/synchronizer_test.cpp).
 
 #include <gtest/gtest.h>
 
@@ -9,7 +9,6 @@
 #include <glm/gtx/quaternion.hpp>
 
 #include "core/scene.hpp"
-#include "viz/overlay_inputs.hpp"
 #include "viz/overlay_renderer.hpp"
 
 namespace mocap::viz {
@@ -373,78 +372,6 @@ TEST(ScenePanel, ViewGrowsAtOnceAndShrinksSlowly) {
   EXPECT_LT(renderer.scene_camera().pixels_per_metre(), 1.2f * wide);  // no jump back
   for (int f = 3; f < 100; ++f) renderer.render({}, near_only, {}, {f, 0.0});
   EXPECT_NEAR(renderer.scene_camera().pixels_per_metre(), close_up, 0.02f * close_up);
-}
-
-// --- joining the inputs by frame
-
-template <class T>
-std::shared_ptr<const T> message(std::int64_t frame) {
-  auto m = std::make_shared<T>();
-  m->header.frame = frame;
-  return m;
-}
-
-TEST(OverlayInputs, FramesAreReadyWhenBothPeopleArrivedInAnyOrder) {
-  OverlayInputs inputs(8, false);
-  inputs.add(message<People3D>(0));
-  EXPECT_TRUE(inputs.take_ready().empty());
-  inputs.add(message<People2D>(0));
-  inputs.add(message<People2D>(1));
-  auto ready = inputs.take_ready();
-  ASSERT_EQ(ready.size(), 1u);
-  EXPECT_EQ(ready[0].frame, 0);
-  inputs.add(message<People3D>(1));
-  ready = inputs.take_ready();
-  ASSERT_EQ(ready.size(), 1u);
-  EXPECT_EQ(ready[0].frame, 1);
-  EXPECT_EQ(inputs.dropped(), 0);
-  EXPECT_EQ(inputs.pending(), 0u);
-}
-
-TEST(OverlayInputs, AFrameSkippedByOneStreamIsDroppedOnceALaterOneIsReady) {
-  OverlayInputs inputs(8, false);
-  inputs.add(message<People2D>(0));
-  inputs.add(message<People2D>(2));  // 2D skipped frame 1
-  inputs.add(message<People3D>(0));
-  inputs.add(message<People3D>(1));
-  inputs.add(message<People3D>(2));
-  const auto ready = inputs.take_ready();
-  ASSERT_EQ(ready.size(), 2u);
-  EXPECT_EQ(ready[1].frame, 2);
-  EXPECT_EQ(inputs.dropped(), 1);
-}
-
-TEST(OverlayInputs, BoundedWhenOneStreamStalls) {
-  OverlayInputs inputs(4, false);
-  for (int f = 0; f < 10; ++f) inputs.add(message<People3D>(f));
-  EXPECT_EQ(inputs.pending(), 4u);
-  EXPECT_EQ(inputs.dropped(), 6);
-}
-
-TEST(OverlayInputs, VideoIsWaitedForOnlyWhenAskedAndUnusedVideoIsNotADrop) {
-  OverlayInputs waits(8, true);
-  waits.add(message<People2D>(0));
-  waits.add(message<People3D>(0));
-  EXPECT_TRUE(waits.take_ready().empty());
-  waits.add(message<VideoFrame>(0));
-  const auto ready = waits.take_ready();
-  ASSERT_EQ(ready.size(), 1u);
-  EXPECT_TRUE(ready[0].video);
-  OverlayInputs takes_what_came(8, false);
-  takes_what_came.add(message<VideoFrame>(0));  // the detector skipped this one
-  takes_what_came.add(message<VideoFrame>(1));
-  takes_what_came.add(message<People2D>(1));
-  takes_what_came.add(message<People3D>(1));
-  const auto drawn = takes_what_came.take_ready();
-  ASSERT_EQ(drawn.size(), 1u);
-  EXPECT_TRUE(drawn[0].video);
-  EXPECT_EQ(takes_what_came.dropped(), 0);
-  // At the end, frames with both people are drawn even without their video.
-  waits.add(message<People2D>(5));
-  waits.add(message<People3D>(5));
-  waits.add(message<People3D>(6));
-  EXPECT_EQ(waits.take_remaining().size(), 1u);
-  EXPECT_EQ(waits.dropped(), 1);
 }
 
 }  // namespace

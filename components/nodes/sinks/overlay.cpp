@@ -1,8 +1,10 @@
 // sink.overlay: the 2D input beside the 3D result, as an MP4 video and/or PNG snapshots. The
-// inputs arrive unsynchronised on their ports; frames are joined by number (viz/overlay_inputs)
-// and drawn by viz/overlay_renderer. The frame under the 2D people comes from the `video` port
-// (cameras, streams) or, with `video_path`, is read again from the file by its frame number
-// (video::FrameReader), so that no decoded frame waits here for its 3D.
+// framework joins the inputs by frame number (Contract::join, graph/synchronizer.hpp): process()
+// sees one frame's 2D people, 3D people and video frame, each present or missing; a frame with
+// both people is drawn (viz/overlay_renderer), on its video frame when there is one. With
+// `video_path` the frame under the people is read again from the file by its number
+// (video::FrameReader) instead of coming on the `video` port, so no decoded frame waits here for
+// its 3D (the offline fit sends it a window later).
 
 #include <chrono>
 #include <iostream>
@@ -11,7 +13,6 @@
 
 #include "graph/registry.hpp"
 #include "video/frame_reader.hpp"
-#include "viz/overlay_inputs.hpp"
 #include "viz/overlay_output.hpp"
 #include "viz/overlay_renderer.hpp"
 
@@ -44,8 +45,9 @@ class OverlaySink : public Node {
     c.param<std::int64_t>("panel_height", 480, "output height in pixels", {16, 16384});
     c.param<double>("view_yaw_deg", 35.0, "3D view: turn about the vertical", {-180.0, 180.0});
     c.param<double>("view_pitch_deg", 30.0, "3D view: looking down by", {-89.0, 89.0});
-    c.param<std::int64_t>("max_pending", 64, "incomplete frames kept at most", {1, 100000});
-    c.param<bool>("wait_for_video", false, "draw a frame only once its video frame is there");
+    // The 3D of a frame comes after its 2D by the lag of the stages between (the offline fit
+    // works in windows of 64 frames per person): held up to sync_bound frames per input.
+    c.join({{"people2d", "people3d", "video"}, SyncKey::frame, 256});
   }
 
   void open(Context& ctx) override {
@@ -64,28 +66,37 @@ class OverlaySink : public Node {
     look.view_yaw_deg = ctx.param<float>("view_yaw_deg");
     look.view_pitch_deg = ctx.param<float>("view_pitch_deg");
     renderer_ = std::make_unique<viz::OverlayRenderer>(look);
-    inputs_ = std::make_unique<viz::OverlayInputs>(ctx.param<std::size_t>("max_pending"),
-                                                   ctx.param<bool>("wait_for_video"));
     if (const auto path = ctx.param<std::string>("video_path"); !path.empty())
       frames_.emplace(path);
   }
 
   void process(Context& ctx) override {
-    const std::int64_t dropped_before = inputs_->dropped();
-    if (ctx.has("people2d")) inputs_->add(ctx.input_ptr<People2D>("people2d"));
-    if (ctx.has("people3d")) inputs_->add(ctx.input_ptr<People3D>("people3d"));
-    if (ctx.has("video") && !frames_) inputs_->add(ctx.input_ptr<VideoFrame>("video"));
-    draw(inputs_->take_ready());
-    for (auto d = dropped_before; d < inputs_->dropped(); ++d) ctx.count_drop();
+    if (!ctx.has("people2d") || !ctx.has("people3d")) {
+      // A frame the detector skipped (video only) is no loss; 2D without 3D or the reverse is
+      // (the synchroniser's line in the statistics says which input was missing or late).
+      if (ctx.has("people2d") || ctx.has("people3d")) {
+        ++undrawn_;
+        ctx.count_drop();
+      }
+      return;
+    }
+    const auto& people3d = ctx.input<People3D>("people3d");
+    ImageBuffer background =
+        ctx.has("video") ? ctx.input<VideoFrame>("video").image : ImageBuffer();
+    if (frames_) {
+      if (auto frame = frames_->frame(people3d.header.frame)) background = std::move(frame->image);
+    }
+    output_->write(renderer_->render(ctx.input<People2D>("people2d"), people3d, background,
+                                     {people3d.header.frame, rate()}),
+                   people3d.header.frame);
   }
 
   void close(Context& ctx) override {
-    if (!inputs_) return;
-    draw(inputs_->take_remaining());
+    if (!output_) return;
     output_->close();
     std::cerr << "sink.overlay '" << ctx.node_name() << "': " << output_->pictures()
-              << " frames drawn, " << inputs_->dropped() << " dropped, " << output_->pngs()
-              << " PNGs";
+              << " frames drawn, " << undrawn_ << " with only 2D or only 3D people, "
+              << output_->pngs() << " PNGs";
     if (frames_)
       std::cerr << "; " << frames_->returned() << " video frames read again, "
                 << frames_->passed_over() << " passed over, " << frames_->reopened() << " restarts";
@@ -93,17 +104,6 @@ class OverlaySink : public Node {
   }
 
  private:
-  void draw(const std::vector<viz::OverlayFrame>& frames) {
-    for (const viz::OverlayFrame& f : frames) {
-      ImageBuffer background = f.video ? f.video->image : ImageBuffer();
-      if (frames_) {
-        if (auto frame = frames_->frame(f.frame)) background = std::move(frame->image);
-      }
-      output_->write(renderer_->render(*f.people2d, *f.people3d, background, {f.frame, rate()}),
-                     f.frame);
-    }
-  }
-
   // Frames drawn per second of wall-clock time, smoothed: how fast the whole graph runs.
   double rate() {
     const auto now = std::chrono::steady_clock::now();
@@ -117,8 +117,8 @@ class OverlaySink : public Node {
 
   std::unique_ptr<viz::OverlayOutput> output_;
   std::unique_ptr<viz::OverlayRenderer> renderer_;
-  std::unique_ptr<viz::OverlayInputs> inputs_;
   std::optional<video::FrameReader> frames_;  // with video_path
+  std::int64_t undrawn_ = 0;
   std::chrono::steady_clock::time_point last_{};
   double fps_ = 0.0;
 };
