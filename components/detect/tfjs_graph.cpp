@@ -30,17 +30,20 @@ constexpr int kMapKey = 1, kMapValue = 2;
 constexpr int kAttrList = 1, kAttrS = 2, kAttrI = 3, kAttrF = 4, kAttrB = 5, kAttrType = 6,
               kAttrShape = 7, kAttrTensor = 8;
 constexpr int kListS = 2, kListI = 3, kListF = 4, kListType = 6;
-constexpr int kTensorDtype = 1, kTensorShape = 2, kTensorContent = 4;
+constexpr int kTensorDtype = 1, kTensorShape = 2, kTensorContent = 4, kTensorIntVal = 7;
 constexpr int kShapeDim = 2, kShapeUnknownRank = 3, kDimSize = 1;
 constexpr int kDtFloat = 1, kDtInt32 = 3;
 }  // namespace pb
 
-// The ops this loader passes to OpenCV (checked on MoveNet MultiPose with OpenCV 4.6); Shape and
-// StridedSlice only occur inside the upsampling chains OpenCV's importer folds into Resize.
+// The ops this loader passes to OpenCV (checked with OpenCV 4.6 on MoveNet MultiPose and
+// single-pose and on MB3-CenterNet's CNN); Shape and StridedSlice only occur inside the upsampling
+// chains OpenCV's importer folds into Resize. Mean is a spatial mean (squeeze-and-excite),
+// ConcatV2 joins channels.
 const std::set<std::string, std::less<>> kPassThroughOps = {
     "Const",   "Placeholder", "Identity", "Conv2D",       "DepthwiseConv2dNative",
     "BiasAdd", "Relu",        "Relu6",    "Add",          "AddV2",
-    "Sub",     "Mul",         "Shape",    "StridedSlice", "ResizeBilinear"};
+    "Sub",     "Mul",         "Shape",    "StridedSlice", "ResizeBilinear",
+    "Sigmoid", "Mean",        "ConcatV2"};
 const std::set<std::string, std::less<>> kSplitOps = {"_FusedConv2D", "FusedDepthwiseConv2dNative"};
 
 struct Node {
@@ -250,7 +253,14 @@ ProtoMessage const_proto(const std::string& name, const Weight& w) {
     shape.add_message(pb::kShapeDim, dim);
   }
   tensor.add_message(pb::kTensorShape, shape);
-  tensor.add_bytes(pb::kTensorContent, w.content);
+  if (w.dtype == pb::kDtInt32 && w.content.size() == sizeof(std::int32_t)) {
+    // A scalar int32 as int_val: OpenCV reads a ConcatV2 axis from there only.
+    std::int32_t value;
+    std::memcpy(&value, w.content.data(), sizeof value);
+    tensor.add_packed_int64(pb::kTensorIntVal, std::vector<std::int64_t>{value});
+  } else {
+    tensor.add_bytes(pb::kTensorContent, w.content);
+  }
   ProtoMessage node = node_proto(name, "Const", {});
   ProtoMessage dtype, value;
   dtype.add_varint(pb::kAttrType, static_cast<std::uint64_t>(w.dtype));
@@ -273,7 +283,7 @@ std::vector<Node> read_nodes(const json& topology) {
 
 // Marks the outputs and everything they depend on.
 std::set<std::string> ancestors(const std::vector<Node>& nodes,
-                                std::span<const std::string> outputs,
+                                std::span<const std::string> outputs, std::string_view input_node,
                                 const std::filesystem::path& model) {
   std::unordered_map<std::string, const Node*> by_name;
   for (const Node& n : nodes) by_name[n.name] = &n;
@@ -285,6 +295,7 @@ std::set<std::string> ancestors(const std::vector<Node>& nodes,
     if (!keep.insert(name).second) continue;
     const auto it = by_name.find(name);
     if (it == by_name.end()) fail(model, "the graph has no node '" + name + "'");
+    if (name == input_node) continue;  // fed from outside: its own inputs are not needed
     for (const std::string& input : it->second->inputs) todo.push_back(base_name(input));
   }
   return keep;
@@ -299,8 +310,9 @@ std::vector<std::string> fused_ops(const Node& n) {
 }
 
 // Empty when the node can be converted, else why not.
-std::string unsupported_reason(const Node& n, const std::map<std::string, const Node*>& kept) {
-  if (kPassThroughOps.contains(n.op)) return {};
+std::string unsupported_reason(const Node& n, const std::map<std::string, const Node*>& kept,
+                               std::string_view input_node) {
+  if (n.name == input_node || kPassThroughOps.contains(n.op)) return {};
   if (kSplitOps.contains(n.op)) {
     const auto ops = fused_ops(n);
     const bool ok =
@@ -320,19 +332,21 @@ std::string unsupported_reason(const Node& n, const std::map<std::string, const 
 }
 
 void check_supported(const std::vector<Node>& nodes, const std::set<std::string>& keep,
-                     const std::filesystem::path& model) {
+                     std::string_view input_node, const std::filesystem::path& model) {
   std::map<std::string, const Node*> kept;
   for (const Node& n : nodes)
     if (keep.contains(n.name)) kept[n.name] = &n;
   std::map<std::string, std::string> refused;  // reason -> first node
   for (const auto& [name, node] : kept) {
-    const std::string reason = unsupported_reason(*node, kept);
+    const std::string reason = unsupported_reason(*node, kept, input_node);
     if (!reason.empty()) refused.try_emplace(reason, name);
   }
   if (refused.empty()) return;
   std::string what = "unsupported operation(s) on the way to the requested outputs:";
   for (const auto& [reason, name] : refused) what += " " + reason + " (node '" + name + "');";
-  fail(model, what + " the cv::dnn loader converts only the operations MoveNet's CNN uses");
+  fail(model, what +
+                  " the cv::dnn loader converts only the operations of the CNNs of MoveNet and "
+                  "MB3-CenterNet");
 }
 
 // Conv2D/DepthwiseConv2dNative -> BiasAdd [-> Relu|Relu6]; the last node keeps the fused node's
@@ -395,7 +409,7 @@ std::string fused_conv_layer_name(std::string_view fused_node) {
 }
 
 std::string tfjs_to_graphdef(const std::filesystem::path& model_json,
-                             std::span<const std::string> outputs) {
+                             std::span<const std::string> outputs, std::string_view input_node) {
   json model;
   try {
     model = json::parse(read_file(model_json, model_json));
@@ -406,8 +420,8 @@ std::string tfjs_to_graphdef(const std::filesystem::path& model_json,
     fail(model_json, "not a TF.js graph model (no modelTopology or weightsManifest)");
   try {
     const std::vector<Node> nodes = read_nodes(model["modelTopology"]);
-    const std::set<std::string> keep = ancestors(nodes, outputs, model_json);
-    check_supported(nodes, keep, model_json);
+    const std::set<std::string> keep = ancestors(nodes, outputs, input_node, model_json);
+    check_supported(nodes, keep, input_node, model_json);
     const auto weights = read_weights(model["weightsManifest"], model_json);
 
     // A Cast from the input placeholder disappears: its consumers read the placeholder, fed float.
@@ -427,7 +441,23 @@ std::string tfjs_to_graphdef(const std::filesystem::path& model_json,
         const auto it = renamed.find(in);
         inputs.push_back(it == renamed.end() ? in : it->second);
       }
-      if (n.op == "Const") {
+      if (n.name == input_node) {
+        // Shaped like the graph's own input (any batch), so that OpenCV knows the layout is NHWC.
+        ProtoMessage p = node_proto(n.name, "Placeholder", {});
+        ProtoMessage dtype;
+        dtype.add_varint(pb::kAttrType, pb::kDtFloat);
+        add_attr(p, "dtype", dtype);
+        for (const Node& original : nodes) {
+          if (original.op != "Placeholder" || !original.attr.contains("shape")) continue;
+          json shape = original.attr["shape"];
+          if (shape.contains("shape") && shape["shape"].contains("dim") &&
+              !shape["shape"]["dim"].empty())
+            shape["shape"]["dim"][0]["size"] = "-1";
+          add_attr(p, "shape", attr_proto("shape", shape));
+          break;
+        }
+        graph.add_message(pb::kGraphNode, p);
+      } else if (n.op == "Const") {
         const auto w = weights.find(n.name);
         if (w == weights.end()) fail(model_json, "Const '" + n.name + "' has no weights");
         graph.add_message(pb::kGraphNode, const_proto(n.name, w->second));

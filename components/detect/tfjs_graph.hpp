@@ -26,8 +26,12 @@ namespace mocap::detect {
 
 // Throws std::runtime_error naming the file and the problem: unreadable or inconsistent files,
 // an output missing from the graph, or every unsupported operation the outputs need.
+// `input_node`, when given, names a node whose result becomes the graph's float input instead
+// (a Placeholder of that name; everything before it is cut): for graphs that wrap their input in
+// operations cv::dnn does not have, like MoveNet single-pose's int32 -> unstack -> expand chain.
 std::string tfjs_to_graphdef(const std::filesystem::path& model_json,
-                             std::span<const std::string> outputs);
+                             std::span<const std::string> outputs,
+                             std::string_view input_node = {});
 
 // The cv::dnn layer that produces the result of a split _FusedConv2D node without activation
 // (OpenCV names a Conv2D + BiasAdd pair after the Conv2D node).
