@@ -1,6 +1,7 @@
-// mocap-bench-video: the whole method on real videos, end to end (decode -> MoveNet -> tracker ->
+// mocap-bench-video: the whole method on real videos, end to end (decode -> detector -> tracker ->
 // scaler -> matcher -> temporal selection -> smoothing -> JSONL, BVH and overlay MP4), per video
-// and detector input size, in two runs each:
+// and detection strategy (mocap reconstruct --detector names; multipose ones per input size), in
+// two runs each:
 //  * offline: every frame, as fast as possible (the graph of `mocap reconstruct VIDEO`):
 //    frames per second, people per frame, tracks longer than 50 frames, id breaks and jumps;
 //  * live: the file replayed at its own rate like a camera, the detector on a `latest` edge and
@@ -21,6 +22,7 @@
 #include <vector>
 
 #include "cli_args.hpp"
+#include "detector_presets.hpp"
 #include "graph/graph_spec.hpp"
 #include "graph/registry.hpp"
 #include "graph/runtime.hpp"
@@ -163,11 +165,22 @@ TrackQuality track_quality(const Records& r) {
 
 struct RunSpec {
   std::string video, db, out_dir;
-  int size = 256;
+  std::string detector = "multipose";  // a preset of tools/mocap/detector_presets.hpp
+  int size = 256;                      // its input size when it is a multipose one
   bool live = false;
   int detector_threads = 0;
   int lag = 8;
 };
+
+std::string detector_node(const RunSpec& s) {
+  const cli::DetectorPreset& preset = cli::detector_preset(s.detector);
+  std::ostringstream node;
+  node << "{ type: " << preset.type << ", params: { threads: " << s.detector_threads;
+  for (const auto& [key, value] : preset.params)
+    node << ", " << key << ": " << (key == "input_size" ? std::to_string(s.size) : value);
+  node << " } }";
+  return node.str();
+}
 
 std::string graph_text(const RunSpec& s, const video::VideoSource& info, const std::string& probe) {
   const double fps = info.fps() > 0 ? info.fps() : 30.0;
@@ -175,8 +188,7 @@ std::string graph_text(const RunSpec& s, const video::VideoSource& info, const s
   g << "graph: bench_video\nnodes:\n"
     << "  src: { type: source.video, params: { path: \"" << s.video
     << "\", mode: " << (s.live ? "live" : "offline") << " } }\n"
-    << "  det: { type: detect.movenet, params: { input_size: " << s.size
-    << ", threads: " << s.detector_threads << " } }\n"
+    << "  det: " << detector_node(s) << "\n"
     << "  track: { type: recon.tracker }\n"
     << "  scale: { type: recon.scaler, params: { db: \"" << s.db << "\" } }\n"
     << "  match: { type: recon.matcher, params: { db: \"" << s.db << "\", k: 32, probe: 16 } }\n"
@@ -288,7 +300,11 @@ int main(int argc, char** argv) {
   args.option("videos", "LIST", "comma-separated video files",
               "/usr/share/doc/opencv-doc/examples/data/vtest.avi,"
               "../shared/data/eval/openpose_examples_media/video.avi")
-      .option("sizes", "LIST", "MoveNet input sizes", "256,384")
+      .option("detectors", "LIST",
+              "detection strategies (mocap reconstruct --detector names: " + cli::detector_names() +
+                  ")",
+              "multipose")
+      .option("sizes", "LIST", "MoveNet input sizes of the multipose detectors", "256,384")
       .option("db", "FILE", "pose database", "build/db/cmu31_train.mdb")
       .option("modes", "LIST", "offline, live or both", "offline,live")
       .option("threads", "N", "detector threads (0: OpenCV's default)", "0")
@@ -298,7 +314,7 @@ int main(int argc, char** argv) {
   if (!args.parse(argc - 1, argv + 1, exit_code)) return exit_code;
   try {
     std::cout
-        << "| video | size | mode | frames | 3D outputs | wall s | fps | people/frame (max) "
+        << "| video | detector | mode | frames | 3D outputs | wall s | fps | people/frame (max) "
            "| 3D people/frame | tracks | tracks > 50 | id breaks | id jumps | latency p50 "
            "ms | p95 ms | p50 first / last quarter ms | src skips | det drops | det p50 ms |\n"
         << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
@@ -307,20 +323,31 @@ int main(int argc, char** argv) {
         std::cout << "| " << video << " | absent, skipped |\n";
         continue;
       }
-      for (const std::string& size : split(args.get("sizes"))) {
+      std::vector<std::pair<std::string, std::string>> variants;  // detector, size
+      for (const std::string& detector : split(args.get("detectors"))) {
+        if (cli::detector_preset(detector).type != "detect.movenet") {
+          variants.emplace_back(detector, "");
+          continue;
+        }
+        for (const std::string& size : split(args.get("sizes")))
+          variants.emplace_back(detector, size);
+      }
+      for (const auto& [detector, size] : variants) {
+        const std::string label = size.empty() ? detector : detector + "@" + size;
         for (const std::string& mode : split(args.get("modes"))) {
           RunSpec spec;
           spec.video = video;
           spec.db = args.get("db");
-          spec.size = std::stoi(size);
+          spec.detector = detector;
+          if (!size.empty()) spec.size = std::stoi(size);
           spec.live = mode == "live";
           spec.detector_threads = std::stoi(args.get("threads"));
           spec.lag = std::stoi(args.get("lag"));
           spec.out_dir = args.get("out") + "/" + std::filesystem::path(video).stem().string() +
-                         "_" + size + "_" + mode;
+                         "_" + label + "_" + mode;
           const Result r = run(spec);
           std::cout << std::fixed << std::setprecision(1) << "| "
-                    << std::filesystem::path(video).filename().string() << " | " << size << " | "
+                    << std::filesystem::path(video).filename().string() << " | " << label << " | "
                     << mode << " | " << r.frames << " | " << r.outputs << " | " << r.wall_s << " | "
                     << r.fps << " | " << std::setprecision(2) << r.people_mean << " ("
                     << r.people_max << ") | " << r.people3d_mean << " | " << r.quality.tracks

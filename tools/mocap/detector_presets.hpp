@@ -1,0 +1,31 @@
+#pragma once
+// The detection strategies by name, as graph nodes: what `mocap reconstruct --detector NAME` puts
+// in the graph and what mocap-bench-video measures (docs/detection-strategies.md).
+
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+namespace mocap::cli {
+
+struct DetectorPreset {
+  std::string name;  // e.g. "topdown"
+  std::string type;  // the node type, e.g. "detect.topdown"
+  std::vector<std::pair<std::string, std::string>> params;
+  std::string doc;  // one line for --help
+};
+
+const std::vector<DetectorPreset>& detector_presets();
+// Throws std::invalid_argument listing the names when `name` is unknown.
+const DetectorPreset& detector_preset(std::string_view name);
+
+// The defaults, chosen by measurement (docs/detection-strategies.md): for a file, find people
+// first; for a live source, keep the rate.
+inline constexpr std::string_view kFileDetector = "topdown";
+inline constexpr std::string_view kLiveDetector = "topdown";
+
+// "a, b, c": the names, for help texts and errors.
+std::string detector_names();
+
+}  // namespace mocap::cli
