@@ -1,5 +1,7 @@
-// detect.movenet in a graph: video frames in, COCO-17 people out with the frames' headers; a
-// missing model or a bad input size stops the graph with an error naming the node and the fix.
+// The detector nodes in a graph (detect.movenet, detect.topdown, detect.tiles): video frames in,
+// COCO-17 people out with the frames' headers, more than MultiPose's 6 per frame where there are
+// more; a missing model or a bad parameter stops the graph with an error naming the node and the
+// fix.
 
 #include <gtest/gtest.h>
 
@@ -8,6 +10,7 @@
 #include <mutex>
 #include <vector>
 
+#include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
 #include "detect/model_files.hpp"
@@ -30,10 +33,13 @@ class ImageFileSource : public Node {
     c.output<VideoFrame>("frames");
     c.required_param<std::string>("path", "image file");
     c.param<int>("count", 1, "frames to send", {1, 1000});
+    c.param<int>("copies", 1, "the image this many times side by side", {1, 4});
   }
   void open(Context& ctx) override {
-    image_ = std::make_shared<cv::Mat>(cv::imread(ctx.param<std::string>("path")));
-    if (image_->empty()) throw std::runtime_error("cannot read " + ctx.param<std::string>("path"));
+    const cv::Mat image = cv::imread(ctx.param<std::string>("path"));
+    if (image.empty()) throw std::runtime_error("cannot read " + ctx.param<std::string>("path"));
+    image_ = std::make_shared<cv::Mat>();
+    cv::repeat(image, 1, ctx.param<int>("copies"), *image_);
     count_ = ctx.param<int>("count");
   }
   void process(Context& ctx) override {
@@ -67,13 +73,14 @@ class CapturePeople2D : public Node {
 };
 MOCAP_REGISTER_NODE("unit.capture_people2d", CapturePeople2D)
 
-std::string graph_yaml(const std::string& detector_params) {
+std::string graph_yaml(const std::string& detector_params,
+                       const std::string& type = "detect.movenet", int copies = 1) {
   return R"(
 nodes:
   src: { type: unit.image_file, params: { path: )" +
-         kFrame.string() + R"(, count: 2 } }
-  det: { type: detect.movenet, params: { )" +
-         detector_params + R"( } }
+         kFrame.string() + ", count: 2, copies: " + std::to_string(copies) + R"( } }
+  det: { type: )" +
+         type + ", params: { " + detector_params + R"( } }
   out: { type: unit.capture_people2d }
 edges:
   - [src.frames, det.in]
@@ -125,6 +132,66 @@ TEST(MovenetNode, RefusesAnInputSizeThatIsNotAMultipleOf32) {
   const RunResult result = testing::run_graph(graph_yaml("input_size: 250"));
   ASSERT_FALSE(result.ok);
   EXPECT_NE(result.error.find("multiple of 32"), std::string::npos) << result.error;
+}
+
+bool models_present() {
+  try {
+    for (const char* name : {"movenet-multipose", "movenet-lightning", "centernet"})
+      detect::cached_model_json(name);
+    return fs::exists(kFrame);
+  } catch (const detect::ModelMissing&) {
+    return false;
+  }
+}
+
+// Two copies of the frame side by side: twelve pedestrians, more than MultiPose's 6 per image.
+TEST(TopDownNode, FindsMoreThanSixPeopleInFramePixels) {
+  if (!models_present()) GTEST_SKIP() << "models or reference frame absent";
+  captured.clear();
+  const RunResult result =
+      testing::run_graph(graph_yaml("detect_every: 1", "detect.topdown", /*copies=*/2));
+  ASSERT_TRUE(result.ok) << result.error;
+  ASSERT_EQ(captured.size(), 2u);
+  for (std::size_t i = 0; i < captured.size(); ++i) {
+    const People2D& people = captured[i];
+    EXPECT_EQ(people.header.frame, static_cast<std::int64_t>(i));
+    EXPECT_EQ(people.layout, LayoutId::coco17);
+    EXPECT_GT(people.people.size(), 6u);
+    int left = 0, right = 0;
+    for (const Person2D& p : people.people) {
+      ASSERT_EQ(p.joints.size(), 17u);
+      EXPECT_GT(p.box.height, 40.0f);
+      EXPECT_LT(p.box.height, 150.0f);
+      (p.box.x + p.box.width / 2 < 768 ? left : right) += 1;
+    }
+    EXPECT_GE(left, 4);  // the pedestrians of both copies
+    EXPECT_GE(right, 4);
+  }
+}
+
+TEST(TilesNode, FindsMoreThanSixPeople) {
+  if (!models_present()) GTEST_SKIP() << "models or reference frame absent";
+  captured.clear();
+  const RunResult result = testing::run_graph(graph_yaml(
+      "columns: 2, rows: 1, tile_input_size: 512, frame_input_size: 0, min_person_score: 0.2",
+      "detect.tiles", /*copies=*/2));
+  ASSERT_TRUE(result.ok) << result.error;
+  ASSERT_EQ(captured.size(), 2u);
+  EXPECT_GT(captured[0].people.size(), 6u);
+}
+
+TEST(TopDownNode, BadParametersAndMissingModelsNameTheNodeAndTheFix) {
+  if (!fs::exists(kFrame)) GTEST_SKIP() << "reference frame absent: " << kFrame;
+  RunResult result = testing::run_graph(graph_yaml("pose_model: sideways", "detect.topdown"));
+  ASSERT_FALSE(result.ok);
+  EXPECT_NE(result.error.find("'det'"), std::string::npos) << result.error;
+  EXPECT_NE(result.error.find("lightning or thunder"), std::string::npos) << result.error;
+  result = testing::run_graph(graph_yaml("box_model_file: /nonexistent/c.json", "detect.topdown"));
+  ASSERT_FALSE(result.ok);
+  EXPECT_NE(result.error.find("tools/setup.sh --models-only"), std::string::npos) << result.error;
+  result = testing::run_graph(graph_yaml("model: /nonexistent/m.json", "detect.tiles"));
+  ASSERT_FALSE(result.ok);
+  EXPECT_NE(result.error.find("tools/setup.sh --models-only"), std::string::npos) << result.error;
 }
 
 }  // namespace

@@ -299,9 +299,10 @@ int main(int argc, char** argv) {
       if (truth) {
         for (const auto& f : truth->frames) at.push_back(f.frame);
       } else {
-        const int n = static_cast<int>(video::is_image_file_name(fs::path(input).filename().string())
-                                           ? 1
-                                           : video::VideoSource(input).frame_count());
+        const int n =
+            static_cast<int>(video::is_image_file_name(fs::path(input).filename().string())
+                                 ? 1
+                                 : video::VideoSource(input).frame_count());
         const int count = std::min(30, n);
         for (int k = 0; k < count; ++k) at.push_back(k * n / count);
       }
