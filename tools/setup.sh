@@ -43,6 +43,7 @@ packages=(
   python3 python3-zmq python3-numpy                     # wire-format client; NumPy cross-check of the npz reader
   libopencv-dev                                         # images and video: overlay, video sources
   libopencv-contrib-dev                                 # cv::aruco: ChArUco boards (mocap calibrate)
+  libavformat-dev libavcodec-dev libavutil-dev libswscale-dev  # overlay.mp4 as a fragmented MP4 (H.264) that a killed run leaves playable
   opencv-doc                                            # vtest.avi, the demo's multi-person video
   blender                                               # a real BVH importer for the tests
   libaravis-dev aravis-tools libusb-1.0-0-dev           # GigE/USB3 Vision (aravis-0.8.pc needs libusb's .pc); fake camera

@@ -2,7 +2,6 @@
 
 #include <cmath>
 
-#include <glm/geometric.hpp>
 #include <nlohmann/json.hpp>
 
 namespace mocap::web {
@@ -21,16 +20,6 @@ Json rounded(double v, double scale) {
 }
 
 }  // namespace
-
-GroundPlane assumed_ground() { return GroundPlane{{0.0f, -1.0f, 0.0f}, 1.5f}; }
-
-glm::vec3 display_root(const GroundPlane& ground, std::size_t slot, std::size_t count) {
-  const float x = (static_cast<float>(slot) - 0.5f * static_cast<float>(count - 1)) * 0.8f;
-  const glm::vec3 ahead(x, 0.0f, 3.0f);
-  const glm::vec3 on_floor =
-      ahead - (glm::dot(ground.normal, ahead) + ground.offset) * ground.normal;
-  return on_floor + 0.95f * ground.normal;
-}
 
 std::string hello_json(const std::string& title) {
   Json bones = Json::array();

@@ -1,14 +1,22 @@
 // sink.overlay in a graph: a playable MP4 with one picture per frame that had both inputs, PNG
-// snapshots, the optional video input under the 2D people, and errors naming the file.
+// snapshots, the optional video input under the 2D people or the frames read again from the file
+// (video_path), and errors naming the file.
 
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <thread>
 
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
 
 #include "sink_test_util.hpp"
 #include "support/small_pose_database.hpp"
+#include "video/mp4_writer.hpp"
 
 namespace mocap::nodes {
 namespace {
@@ -27,7 +35,7 @@ std::string two_people_script(int frames) {
 }
 
 int count_video_frames(const std::string& path, cv::Size& size) {
-  cv::VideoCapture video(path);
+  cv::VideoCapture video(path, cv::CAP_FFMPEG);
   if (!video.isOpened()) return -1;
   int frames = 0;
   for (cv::Mat picture; video.read(picture); ++frames) size = picture.size();
@@ -88,6 +96,94 @@ edges:
   const cv::Vec3b corner = picture.at<cv::Vec3b>(470, 840);
   EXPECT_NEAR(corner[2], 200, 8);
   EXPECT_LT(corner[0] + corner[1], 16);
+}
+
+// With video_path the overlay reads the frame under the 2D people from the file by frame number
+// (the script's frames 0..11 are the file's frames 0..11, each its own grey), and the video port
+// is not needed.
+TEST(OverlaySink, VideoPathFramesAreReadAgainByFrameNumber) {
+  MOCAP_REQUIRE_SMALL_DATABASE(db);
+  test::TempDir dir;
+  const std::string clip = dir.file("clip.mp4");
+  {
+    video::Mp4Writer writer(clip, 320, 180, {10.0});
+    for (int k = 0; k < 12; ++k) {
+      ImageBuffer grey(320, 180, PixelFormat::bgr8);
+      for (std::byte& b : grey.pixels_for_writing()) b = std::byte(20 * k);
+      writer.write(grey);
+    }
+  }
+  const graph::RunResult result = run_graph(R"(
+nodes:
+  src: { type: unit.people_script, params: { db: )" +
+                                            db + ", script: \"" + two_people_script(12) + R"(" } }
+  overlay: { type: sink.overlay, params: { video_path: )" +
+                                            clip + ", video: " + dir.file("overlay.mp4") +
+                                            ", png_every: 1, png_dir: " + dir.file("png") + R"( } }
+edges:
+  - [src.people2d, overlay.people2d]
+  - [src.people3d, overlay.people3d]
+)");
+  ASSERT_TRUE(result.ok) << result.error;
+  cv::Size size;
+  EXPECT_EQ(count_video_frames(dir.file("overlay.mp4"), size), 12);
+  for (int k = 0; k < 12; ++k) {
+    char name[32];
+    std::snprintf(name, sizeof name, "png/overlay_%06d.png", k);
+    const cv::Mat picture = cv::imread(dir.file(name));
+    ASSERT_FALSE(picture.empty()) << name;
+    const cv::Vec3b corner = picture.at<cv::Vec3b>(470, 840);  // the video, away from people
+    EXPECT_NEAR(corner[1], 20 * k, 4) << name;
+  }
+}
+
+// A child process runs the graph with a source that never ends; SIGKILL lands while the overlay
+// writes. The video plays: OpenCV decodes every picture the file had when the parent last looked.
+TEST(OverlaySink, VideoOfAKilledRunPlays) {
+  MOCAP_REQUIRE_SMALL_DATABASE(db);
+  test::TempDir dir;
+  for (int round = 0; round < 2; ++round) {
+    const std::string mp4 = dir.file("killed" + std::to_string(round) + ".mp4");
+    const std::string graph = R"(
+nodes:
+  src: { type: unit.people_script, params: { db: )" +
+                              db + ", script: \"" + two_people_script(5) +
+                              R"(", repeat: true, interval_ms: 5 } }
+  overlay: { type: sink.overlay, params: { video: )" +
+                              mp4 + R"(, panel_height: 240 } }
+edges:
+  - [src.people2d, overlay.people2d]
+  - [src.people3d, overlay.people3d]
+)";
+    const pid_t child = fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {
+      run_graph(graph);  // runs until killed
+      _exit(2);
+    }
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+    auto size_now = [&] {
+      std::error_code ec;
+      const auto bytes = std::filesystem::file_size(mp4, ec);
+      return ec ? 0u : bytes;
+    };
+    while (size_now() < 20000u && std::chrono::steady_clock::now() < deadline)
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    std::this_thread::sleep_for(std::chrono::milliseconds(50 + 61 * round));
+    // The pictures in the file by now: written whole before the kill, so they must all decode.
+    cv::Size size;
+    const int before_kill = count_video_frames(mp4, size);
+    ASSERT_EQ(kill(child, SIGKILL), 0);
+    int status = 0;
+    ASSERT_EQ(waitpid(child, &status, 0), child);
+    ASSERT_TRUE(WIFSIGNALED(status)) << "the graph ended by itself";
+    const int after_kill = count_video_frames(mp4, size);
+    std::cout << "[ note ] round " << round << ": " << before_kill
+              << " pictures decoded before the kill, " << after_kill << " after\n";
+    EXPECT_GT(before_kill, 0);
+    EXPECT_GE(after_kill, before_kill);
+    EXPECT_EQ(size, cv::Size(2 * 426, 240));
+  }
 }
 
 TEST(OverlaySink, UnwritableVideoFailsTheGraphNamingTheFile) {

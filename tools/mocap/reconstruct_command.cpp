@@ -13,6 +13,7 @@
 #include <iostream>
 #include <map>
 #include <sstream>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -95,6 +96,18 @@ std::string number(double value) {
   return out.str();
 }
 
+// A file or image folder is read a second time by the overlay, by frame number as the 3D of each
+// frame arrives (its video_path), instead of through an edge from the source: no decoded frame
+// waits in the overlay for its 3D (a full fit sends it a window later), and the overlay never
+// holds the source up. Cameras and streams cannot be read twice and keep the edge.
+void read_frames_in_overlay(graph::GraphSpec& spec, const std::string& input) {
+  set_param(spec, "sink.overlay", "video_path", input);
+  std::erase_if(spec.edges, [&](const graph::EdgeSpec& edge) {
+    const graph::NodeSpec* to = spec.find_node(edge.to.node);
+    return to && to->type == "sink.overlay" && edge.to.port == "video";
+  });
+}
+
 void configure_video(graph::GraphSpec& spec, const Args& args, const VideoInfo& info) {
   set_param(spec, "source.video", "path", args.positionals()[0]);
   set_param(spec, "source.video", "decoder_threads", args.get("decoder-threads"));
@@ -120,6 +133,7 @@ void configure_video(graph::GraphSpec& spec, const Args& args, const VideoInfo& 
   }
   set_param(spec, "sink.overlay", "canvas_width", width);
   set_param(spec, "sink.overlay", "canvas_height", height);
+  if (!info.live) read_frames_in_overlay(spec, args.positionals()[0]);
 }
 
 bool is_detector(const std::string& type) {

@@ -1,12 +1,16 @@
 // sink.overlay: the 2D input beside the 3D result, as an MP4 video and/or PNG snapshots. The
 // inputs arrive unsynchronised on their ports; frames are joined by number (viz/overlay_inputs)
-// and drawn by viz/overlay_renderer.
+// and drawn by viz/overlay_renderer. The frame under the 2D people comes from the `video` port
+// (cameras, streams) or, with `video_path`, is read again from the file by its frame number
+// (video::FrameReader), so that no decoded frame waits here for its 3D.
 
 #include <chrono>
 #include <iostream>
 #include <memory>
+#include <optional>
 
 #include "graph/registry.hpp"
+#include "video/frame_reader.hpp"
 #include "viz/overlay_inputs.hpp"
 #include "viz/overlay_output.hpp"
 #include "viz/overlay_renderer.hpp"
@@ -20,9 +24,16 @@ class OverlaySink : public Node {
     c.doc("Draws the 2D input beside the 3D skeletons (second viewpoint) into an MP4 and/or PNGs");
     c.input<People2D>("people2d", "the tracked 2D people (any keypoint layout)");
     c.input<People3D>("people3d", "the reconstructed 3D people");
-    c.input<VideoFrame>("video", "the frames the 2D people were found in (drawn under them)",
+    c.input<VideoFrame>("video",
+                        "the frames the 2D people were found in (drawn under them); unused "
+                        "with video_path",
                         PortFlag::optional);
-    c.param<std::string>("video", "", "MP4 file to write (codec mp4v); empty: none");
+    c.param<std::string>("video_path", "",
+                         "video file or image folder the 2D people were found in, read again by "
+                         "frame number (instead of the video port; not for cameras and streams)");
+    c.param<std::string>("video", "",
+                         "MP4 file to write (fragmented, H.264: plays even if the run is killed); "
+                         "empty: none");
     c.param<double>("fps", 30.0, "frame rate of the MP4", {0.1, 1000.0});
     c.param<std::int64_t>("png_every", 0, "a PNG of every Nth drawn frame; 0: none", {0, 1e9});
     c.param<std::string>("png_dir", "", "folder for the PNGs (overlay_<frame>.png)");
@@ -32,7 +43,7 @@ class OverlaySink : public Node {
                           {16, 16384});
     c.param<std::int64_t>("panel_height", 480, "output height in pixels", {16, 16384});
     c.param<double>("view_yaw_deg", 35.0, "3D view: turn about the vertical", {-180.0, 180.0});
-    c.param<double>("view_pitch_deg", 20.0, "3D view: looking down by", {-89.0, 89.0});
+    c.param<double>("view_pitch_deg", 30.0, "3D view: looking down by", {-89.0, 89.0});
     c.param<std::int64_t>("max_pending", 64, "incomplete frames kept at most", {1, 100000});
     c.param<bool>("wait_for_video", false, "draw a frame only once its video frame is there");
   }
@@ -55,13 +66,15 @@ class OverlaySink : public Node {
     renderer_ = std::make_unique<viz::OverlayRenderer>(look);
     inputs_ = std::make_unique<viz::OverlayInputs>(ctx.param<std::size_t>("max_pending"),
                                                    ctx.param<bool>("wait_for_video"));
+    if (const auto path = ctx.param<std::string>("video_path"); !path.empty())
+      frames_.emplace(path);
   }
 
   void process(Context& ctx) override {
     const std::int64_t dropped_before = inputs_->dropped();
     if (ctx.has("people2d")) inputs_->add(ctx.input_ptr<People2D>("people2d"));
     if (ctx.has("people3d")) inputs_->add(ctx.input_ptr<People3D>("people3d"));
-    if (ctx.has("video")) inputs_->add(ctx.input_ptr<VideoFrame>("video"));
+    if (ctx.has("video") && !frames_) inputs_->add(ctx.input_ptr<VideoFrame>("video"));
     draw(inputs_->take_ready());
     for (auto d = dropped_before; d < inputs_->dropped(); ++d) ctx.count_drop();
   }
@@ -72,13 +85,20 @@ class OverlaySink : public Node {
     output_->close();
     std::cerr << "sink.overlay '" << ctx.node_name() << "': " << output_->pictures()
               << " frames drawn, " << inputs_->dropped() << " dropped, " << output_->pngs()
-              << " PNGs\n";
+              << " PNGs";
+    if (frames_)
+      std::cerr << "; " << frames_->returned() << " video frames read again, "
+                << frames_->passed_over() << " passed over, " << frames_->reopened() << " restarts";
+    std::cerr << "\n";
   }
 
  private:
   void draw(const std::vector<viz::OverlayFrame>& frames) {
     for (const viz::OverlayFrame& f : frames) {
-      const ImageBuffer background = f.video ? f.video->image : ImageBuffer();
+      ImageBuffer background = f.video ? f.video->image : ImageBuffer();
+      if (frames_) {
+        if (auto frame = frames_->frame(f.frame)) background = std::move(frame->image);
+      }
       output_->write(renderer_->render(*f.people2d, *f.people3d, background, {f.frame, rate()}),
                      f.frame);
     }
@@ -98,6 +118,7 @@ class OverlaySink : public Node {
   std::unique_ptr<viz::OverlayOutput> output_;
   std::unique_ptr<viz::OverlayRenderer> renderer_;
   std::unique_ptr<viz::OverlayInputs> inputs_;
+  std::optional<video::FrameReader> frames_;  // with video_path
   std::chrono::steady_clock::time_point last_{};
   double fps_ = 0.0;
 };
