@@ -43,6 +43,7 @@ packages=(
   python3 python3-zmq python3-numpy                     # wire-format client; NumPy cross-check of the npz reader
   libopencv-dev                                         # images and video: overlay, video sources
   libopencv-contrib-dev                                 # cv::aruco: ChArUco boards (mocap calibrate)
+  libxnnpack-dev libpthreadpool-dev                     # XNNPACK: the faster CPU runtime of the 2D networks
   opencv-doc                                            # vtest.avi, the demo's multi-person video
   blender                                               # a real BVH importer for the tests
   libaravis-dev aravis-tools libusb-1.0-0-dev           # GigE/USB3 Vision (aravis-0.8.pc needs libusb's .pc); fake camera

@@ -16,11 +16,12 @@
 // [-> Relu | Relu6]. Any other op outside the short list it has been checked with is refused by
 // name, before OpenCV sees the graph.
 
-#include <cstdint>
 #include <filesystem>
 #include <span>
 #include <string>
 #include <string_view>
+
+#include "detect/tfjs_model.hpp"
 
 namespace mocap::detect {
 
@@ -28,12 +29,10 @@ namespace mocap::detect {
 // an output missing from the graph, or every unsupported operation the outputs need.
 std::string tfjs_to_graphdef(const std::filesystem::path& model_json,
                              std::span<const std::string> outputs);
+std::string tfjs_to_graphdef(const TfjsModel& model, std::span<const std::string> outputs);
 
 // The cv::dnn layer that produces the result of a split _FusedConv2D node without activation
 // (OpenCV names a Conv2D + BiasAdd pair after the Conv2D node).
 std::string fused_conv_layer_name(std::string_view fused_node);
-
-// IEEE 754 binary16 (as stored in TF.js float16-quantised weights) to float.
-float half_to_float(std::uint16_t half);
 
 }  // namespace mocap::detect
