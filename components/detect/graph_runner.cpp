@@ -6,7 +6,7 @@
 
 namespace mocap::detect {
 
-std::size_t Tensor::size() const {
+std::size_t GraphTensor::size() const {
   std::size_t n = 1;
   for (const std::int64_t d : shape) n *= static_cast<std::size_t>(d);
   return n;
@@ -54,7 +54,7 @@ std::unique_ptr<GraphRunner> make_graph_runner(std::shared_ptr<const TfjsModel> 
     if (!initialise_xnnpack())
       throw std::runtime_error("XNNPACK does not run on this processor; use backend opencv");
     try {
-      return make_xnnpack_runner(model, outputs, options.threads);
+      return make_xnnpack_runner(model, outputs, options);
     } catch (const ModelError&) {
       // `auto` falls back to cv::dnn for a model XNNPACK is not given for; asked by name, the
       // error (naming the operations) stands.
@@ -66,7 +66,7 @@ std::unique_ptr<GraphRunner> make_graph_runner(std::shared_ptr<const TfjsModel> 
         "was configured); use backend opencv or auto");
 #endif
   }
-  return make_opencv_runner(std::move(model), outputs, options.threads);
+  return make_opencv_runner(std::move(model), outputs, options);
 }
 
 std::unique_ptr<GraphRunner> make_graph_runner(const std::filesystem::path& model_json,

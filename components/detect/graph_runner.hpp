@@ -24,14 +24,14 @@ namespace mocap::detect {
 
 struct TfjsModel;
 
-struct Tensor {
+struct GraphTensor {
   std::vector<std::int64_t> shape;
   std::vector<float> values;  // row-major, shape's product many
 
   std::size_t size() const;  // product of the shape (1 for a scalar)
 };
 
-struct TensorView {
+struct GraphTensorView {
   std::span<const std::int64_t> shape;
   std::span<const float> values;
 };
@@ -55,6 +55,10 @@ struct RunnerOptions {
   // process-wide cv::setNumThreads (the last runner made decides). 0: the runtime's default
   // (XNNPACK: 1 thread per core; cv::dnn: OpenCV's default).
   int threads = 0;
+  // Feed the network at this node instead of its input placeholder (empty: the placeholder), e.g.
+  // single-pose MoveNet at "StatefulPartitionedCall/stack", after the batch-of-one reshuffles
+  // of its int32 input, to run a batch of crops. The node's own inputs are then not needed.
+  std::string input_node;
 };
 
 class GraphRunner {
@@ -65,7 +69,7 @@ class GraphRunner {
   // fills `outputs` with the requested outputs, in the order they were requested. Reuses the
   // vectors' storage from call to call. Throws std::invalid_argument for an input of the wrong
   // rank or size, std::runtime_error when the runtime fails.
-  virtual void run(const TensorView& input, std::vector<Tensor>& outputs) = 0;
+  virtual void run(const GraphTensorView& input, std::vector<GraphTensor>& outputs) = 0;
 
   virtual Backend backend() const = 0;
 };

@@ -44,6 +44,13 @@ int to_rgb_code(PixelFormat format) {
   return -1;
 }
 
+RunnerOptions runner_options(const MovenetOptions& options) {
+  RunnerOptions r;
+  r.backend = options.backend;
+  r.threads = options.threads;
+  return r;
+}
+
 }  // namespace
 
 MovenetInput prepare_movenet_input(const ImageBuffer& image, int input_size) {
@@ -82,7 +89,7 @@ MovenetInput prepare_movenet_input(const ImageBuffer& image, int input_size) {
 MovenetDetector::MovenetDetector(const std::filesystem::path& model_json,
                                  const MovenetOptions& options)
     : options_((check_input_size(options.input_size), options)),
-      network_(model_json, {options.backend, options.threads}) {}
+      network_(model_json, runner_options(options)) {}
 
 std::vector<MovenetPerson> MovenetDetector::detect(const ImageBuffer& image) {
   const MovenetInput input = prepare_movenet_input(image, options_.input_size);

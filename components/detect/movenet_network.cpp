@@ -73,7 +73,7 @@ void MovenetNetwork::run(const ImageBuffer& tensor, MovenetHeads& heads) {
                                                       &heads.box_offset, &heads.heatmap,
                                                       &heads.regress,    &heads.offset};
   for (std::size_t i = 0; i < targets.size(); ++i) {
-    const Tensor& out = outputs_[i];
+    const GraphTensor& out = outputs_[i];
     if (out.shape != std::vector<std::int64_t>{1, heads.height, heads.width, kHeadChannels[i]})
       throw std::runtime_error("MoveNet head " + kHeadNodes[i] + " has an unexpected shape");
     targets[i]->swap(outputs_[i].values);  // the runner refills its vector next time

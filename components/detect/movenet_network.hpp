@@ -32,7 +32,7 @@ class MovenetNetwork {
  private:
   std::unique_ptr<GraphRunner> runner_;
   std::vector<float> input_;
-  std::vector<Tensor> outputs_;
+  std::vector<GraphTensor> outputs_;
 };
 
 }  // namespace mocap::detect

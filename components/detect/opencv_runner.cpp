@@ -32,7 +32,7 @@ std::string layer_name(const TfjsModel& model, const std::string& output) {
 }
 
 // NHWC-ordered [a, b, c, d] values to the NCHW blob [a, d, b, c], and back.
-void to_blob(const TensorView& input, cv::Mat& blob) {
+void to_blob(const GraphTensorView& input, cv::Mat& blob) {
   const auto& s = input.shape;
   const int dims[] = {static_cast<int>(s[0]), static_cast<int>(s[3]), static_cast<int>(s[1]),
                       static_cast<int>(s[2])};
@@ -48,7 +48,7 @@ void to_blob(const TensorView& input, cv::Mat& blob) {
   }
 }
 
-void from_blob(const cv::Mat& blob, Tensor& out) {
+void from_blob(const cv::Mat& blob, GraphTensor& out) {
   const cv::Mat m = blob.isContinuous() ? blob : blob.clone();
   const float* in = m.ptr<float>();
   if (m.dims != 4) {
@@ -71,19 +71,20 @@ void from_blob(const cv::Mat& blob, Tensor& out) {
 
 class OpenCvRunner : public GraphRunner {
  public:
-  OpenCvRunner(const TfjsModel& model, std::span<const std::string> outputs, int threads)
+  OpenCvRunner(const TfjsModel& model, std::span<const std::string> outputs,
+               const RunnerOptions& options)
       : file_(model.file) {
-    const std::string graph = tfjs_to_graphdef(model, outputs);
+    const std::string graph = tfjs_to_graphdef(model, outputs, options.input_node);
     try {
       net_ = cv::dnn::readNetFromTensorflow(graph.data(), graph.size());
     } catch (const cv::Exception& e) {
       fail_model(model.file, std::string("cv::dnn could not import it: ") + e.what());
     }
     for (const std::string& output : outputs) names_.push_back(layer_name(model, output));
-    if (threads > 0) cv::setNumThreads(threads);
+    if (options.threads > 0) cv::setNumThreads(options.threads);
   }
 
-  void run(const TensorView& input, std::vector<Tensor>& outputs) override {
+  void run(const GraphTensorView& input, std::vector<GraphTensor>& outputs) override {
     std::size_t size = 1;
     for (const std::int64_t d : input.shape) {
       if (d <= 0) throw std::invalid_argument("network input with an empty dimension");
@@ -115,8 +116,9 @@ class OpenCvRunner : public GraphRunner {
 }  // namespace
 
 std::unique_ptr<GraphRunner> make_opencv_runner(std::shared_ptr<const TfjsModel> model,
-                                                std::span<const std::string> outputs, int threads) {
-  return std::make_unique<OpenCvRunner>(*model, outputs, threads);
+                                                std::span<const std::string> outputs,
+                                                const RunnerOptions& options) {
+  return std::make_unique<OpenCvRunner>(*model, outputs, options);
 }
 
 }  // namespace mocap::detect

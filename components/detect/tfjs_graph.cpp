@@ -22,17 +22,20 @@ constexpr int kMapKey = 1, kMapValue = 2;
 constexpr int kAttrList = 1, kAttrS = 2, kAttrI = 3, kAttrF = 4, kAttrB = 5, kAttrType = 6,
               kAttrShape = 7, kAttrTensor = 8;
 constexpr int kListS = 2, kListI = 3, kListF = 4, kListType = 6;
-constexpr int kTensorDtype = 1, kTensorShape = 2, kTensorContent = 4;
+constexpr int kTensorDtype = 1, kTensorShape = 2, kTensorContent = 4, kTensorIntVal = 7;
 constexpr int kShapeDim = 2, kShapeUnknownRank = 3, kDimSize = 1;
 constexpr int kDtFloat = 1, kDtInt32 = 3;
 }  // namespace pb
 
-// The ops this loader passes to OpenCV (checked on MoveNet MultiPose with OpenCV 4.6); Shape and
-// StridedSlice only occur inside the upsampling chains OpenCV's importer folds into Resize.
+// The ops this loader passes to OpenCV (checked with OpenCV 4.6 on MoveNet MultiPose and
+// single-pose and MB3-CenterNet; NanoDet's NCHW transposes are beyond OpenCV's TF importer); Shape
+// and StridedSlice only occur inside the upsampling chains OpenCV's importer folds into Resize;
+// Mean is a spatial mean (squeeze-and-excite).
 const std::set<std::string, std::less<>> kPassThroughOps = {
     "Const",   "Placeholder", "Identity", "Conv2D",       "DepthwiseConv2dNative",
     "BiasAdd", "Relu",        "Relu6",    "Add",          "AddV2",
-    "Sub",     "Mul",         "Shape",    "StridedSlice", "ResizeBilinear"};
+    "Sub",     "Mul",         "Shape",    "StridedSlice", "ResizeBilinear",
+    "Sigmoid", "Mean",        "ConcatV2"};
 const std::set<std::string, std::less<>> kSplitOps = {"_FusedConv2D", "FusedDepthwiseConv2dNative"};
 
 ProtoMessage attr_proto(const TfjsAttr& a) {
@@ -116,12 +119,17 @@ ProtoMessage const_proto(const std::string& name, const TfjsWeight& w) {
     shape.add_message(pb::kShapeDim, dim);
   }
   tensor.add_message(pb::kTensorShape, shape);
-  // Little-endian float32 / int32 values, as TensorProto.tensor_content.
-  const std::string_view content =
-      w.is_int
-          ? std::string_view(reinterpret_cast<const char*>(w.ints.data()), w.ints.size() * 4)
-          : std::string_view(reinterpret_cast<const char*>(w.floats.data()), w.floats.size() * 4);
-  tensor.add_bytes(pb::kTensorContent, content);
+  if (w.is_int && w.ints.size() == 1) {
+    // A scalar int32 as int_val: OpenCV reads a ConcatV2 / Split axis from there only.
+    tensor.add_packed_int64(pb::kTensorIntVal, std::vector<std::int64_t>{w.ints[0]});
+  } else {
+    // Little-endian float32 / int32 values, as TensorProto.tensor_content.
+    const std::string_view content =
+        w.is_int
+            ? std::string_view(reinterpret_cast<const char*>(w.ints.data()), w.ints.size() * 4)
+            : std::string_view(reinterpret_cast<const char*>(w.floats.data()), w.floats.size() * 4);
+    tensor.add_bytes(pb::kTensorContent, content);
+  }
   ProtoMessage node = node_proto(name, "Const", {});
   ProtoMessage dtype_attr, value;
   dtype_attr.add_varint(pb::kAttrType, static_cast<std::uint64_t>(dtype));
@@ -153,12 +161,14 @@ std::string unsupported_reason(const TfjsNode& n,
   return n.op;
 }
 
-void check_supported(const TfjsModel& model, const std::set<std::string>& keep) {
+void check_supported(const TfjsModel& model, const std::set<std::string>& keep,
+                     std::string_view input_node) {
   std::map<std::string, const TfjsNode*> kept;
   for (const TfjsNode& n : model.nodes)
     if (keep.contains(n.name)) kept[n.name] = &n;
   std::map<std::string, std::string> refused;  // reason -> first node
   for (const auto& [name, node] : kept) {
+    if (name == input_node) continue;
     const std::string reason = unsupported_reason(*node, kept);
     if (!reason.empty()) refused.try_emplace(reason, name);
   }
@@ -166,7 +176,9 @@ void check_supported(const TfjsModel& model, const std::set<std::string>& keep) 
   std::string what = "unsupported operation(s) on the way to the requested outputs:";
   for (const auto& [reason, name] : refused) what += " " + reason + " (node '" + name + "');";
   fail_model(model.file,
-             what + " the cv::dnn loader converts only the operations MoveNet's CNN uses");
+             what +
+                 " the cv::dnn loader converts only the operations of the CNNs of MoveNet and "
+                 "MB3-CenterNet (the XNNPACK runtime runs more)");
 }
 
 // Conv2D/DepthwiseConv2dNative -> BiasAdd [-> Relu|Relu6]; the last node keeps the fused node's
@@ -195,7 +207,7 @@ void emit_split(ProtoMessage& graph, const TfjsNode& n, const std::vector<std::s
 }
 
 void emit_placeholder(ProtoMessage& graph, const TfjsNode& n, bool fed_as_float) {
-  ProtoMessage p = node_proto(n.name, n.op, {});
+  ProtoMessage p = node_proto(n.name, "Placeholder", {});
   if (fed_as_float) {
     ProtoMessage dtype;
     dtype.add_varint(pb::kAttrType, pb::kDtFloat);
@@ -207,22 +219,28 @@ void emit_placeholder(ProtoMessage& graph, const TfjsNode& n, bool fed_as_float)
   graph.add_message(pb::kGraphNode, p);
 }
 
-std::string write_graphdef(const TfjsModel& model, std::span<const std::string> outputs) {
-  const std::set<std::string> keep = tfjs_ancestors(model, outputs);
-  check_supported(model, keep);
+std::string write_graphdef(const TfjsModel& model, std::span<const std::string> outputs,
+                           std::string_view requested_input) {
+  const std::string input_node = tfjs_resolve(model, std::string(requested_input));
+  const std::set<std::string> keep = tfjs_ancestors(model, outputs, input_node);
+  check_supported(model, keep, input_node);
 
   // A Cast from the input placeholder disappears: its consumers read the placeholder, fed float.
   std::unordered_map<std::string, std::string> renamed;
   std::set<std::string> float_inputs;
   for (const TfjsNode& n : model.nodes) {
-    if (keep.contains(n.name) && n.op == "Cast") {
+    if (keep.contains(n.name) && n.op == "Cast" && n.name != input_node) {
       renamed[n.name] = tfjs_base_name(n.inputs[0]);
       float_inputs.insert(tfjs_base_name(n.inputs[0]));
     }
   }
   ProtoMessage graph;
   for (const TfjsNode& n : model.nodes) {
-    if (!keep.contains(n.name) || n.op == "Cast") continue;
+    if (!keep.contains(n.name) || (n.op == "Cast" && n.name != input_node)) continue;
+    if (n.name == input_node) {  // fed from outside: a float placeholder of that name
+      emit_placeholder(graph, n, true);
+      continue;
+    }
     std::vector<std::string> inputs;
     for (const std::string& in : n.inputs) {
       const auto it = renamed.find(in);
@@ -256,13 +274,14 @@ std::string fused_conv_layer_name(std::string_view fused_node) {
 }
 
 std::string tfjs_to_graphdef(const std::filesystem::path& model_json,
-                             std::span<const std::string> outputs) {
-  return tfjs_to_graphdef(read_tfjs_model(model_json), outputs);
+                             std::span<const std::string> outputs, std::string_view input_node) {
+  return tfjs_to_graphdef(read_tfjs_model(model_json), outputs, input_node);
 }
 
-std::string tfjs_to_graphdef(const TfjsModel& model, std::span<const std::string> outputs) {
+std::string tfjs_to_graphdef(const TfjsModel& model, std::span<const std::string> outputs,
+                             std::string_view input_node) {
   try {
-    return write_graphdef(model, outputs);
+    return write_graphdef(model, outputs, input_node);
   } catch (const ModelError&) {
     throw;
   } catch (const std::exception& e) {

@@ -27,9 +27,13 @@ namespace mocap::detect {
 
 // Throws std::runtime_error naming the file and the problem: unreadable or inconsistent files,
 // an output missing from the graph, or every unsupported operation the outputs need.
+// `input_node` (empty: the placeholder) is fed from outside instead, as a float placeholder of
+// that name; what it depends on is left out.
 std::string tfjs_to_graphdef(const std::filesystem::path& model_json,
-                             std::span<const std::string> outputs);
-std::string tfjs_to_graphdef(const TfjsModel& model, std::span<const std::string> outputs);
+                             std::span<const std::string> outputs,
+                             std::string_view input_node = {});
+std::string tfjs_to_graphdef(const TfjsModel& model, std::span<const std::string> outputs,
+                             std::string_view input_node = {});
 
 // The cv::dnn layer that produces the result of a split _FusedConv2D node without activation
 // (OpenCV names a Conv2D + BiasAdd pair after the Conv2D node).

@@ -209,6 +209,7 @@ void bypass_batch_of_one_noops(TfjsModel& model) {
   };
   for (TfjsNode& n : model.nodes)
     for (std::string& input : n.inputs) input = resolve(input);
+  for (const auto& [name, target] : replacement) model.bypassed[name] = resolve(target);
 }
 
 }  // namespace
@@ -246,6 +247,11 @@ TfjsModel read_tfjs_model(const std::filesystem::path& model_json) {
   }
 }
 
+std::string tfjs_resolve(const TfjsModel& model, const std::string& name) {
+  const auto it = model.bypassed.find(name);
+  return it == model.bypassed.end() ? name : it->second;
+}
+
 std::string tfjs_base_name(std::string_view input) {
   if (!input.empty() && input.front() == '^') input.remove_prefix(1);
   const auto colon = input.find(':');
@@ -263,7 +269,8 @@ int tfjs_output_index(std::string_view input) {
   return index;
 }
 
-std::set<std::string> tfjs_ancestors(const TfjsModel& model, std::span<const std::string> outputs) {
+std::set<std::string> tfjs_ancestors(const TfjsModel& model, std::span<const std::string> outputs,
+                                     std::string_view input_node) {
   std::unordered_map<std::string, const TfjsNode*> by_name;
   for (const TfjsNode& n : model.nodes) by_name[n.name] = &n;
   std::set<std::string> keep;
@@ -275,6 +282,7 @@ std::set<std::string> tfjs_ancestors(const TfjsModel& model, std::span<const std
     if (!keep.insert(name).second) continue;
     const auto it = by_name.find(name);
     if (it == by_name.end()) fail_model(model.file, "the graph has no node '" + name + "'");
+    if (name == input_node) continue;  // fed from outside
     for (const std::string& input : it->second->inputs) todo.push_back(tfjs_base_name(input));
   }
   return keep;

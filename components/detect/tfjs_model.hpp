@@ -65,6 +65,8 @@ struct TfjsModel {
   std::vector<TfjsNode> nodes;
   std::unordered_map<std::string, TfjsWeight> weights;
   int producer = 808;  // GraphDef versions.producer
+  // Nodes bypassed when the model was read (below) -> the node their consumers read instead.
+  std::unordered_map<std::string, std::string> bypassed;
 };
 
 // The graph is read as it is, except that the batch-of-one no-ops the TF.js converter leaves at
@@ -74,8 +76,14 @@ struct TfjsModel {
 // shorter or longer than their manifest, or weights of a type it does not read.
 TfjsModel read_tfjs_model(const std::filesystem::path& model_json);
 
-// The outputs and every node they depend on. Throws ModelError for a name the graph lacks.
-std::set<std::string> tfjs_ancestors(const TfjsModel& model, std::span<const std::string> outputs);
+// The outputs and every node they depend on, up to `input_node` (fed from outside: its own inputs
+// are not needed; empty: none). Throws ModelError for a name the graph lacks.
+std::set<std::string> tfjs_ancestors(const TfjsModel& model, std::span<const std::string> outputs,
+                                     std::string_view input_node = {});
+
+// The node that stands for `name` after the bypasses (`name` itself when it was not bypassed): an
+// input node given by name is fed there.
+std::string tfjs_resolve(const TfjsModel& model, const std::string& name);
 
 // "x:1" -> "x", "^x" -> "x".
 std::string tfjs_base_name(std::string_view input);

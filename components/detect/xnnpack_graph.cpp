@@ -175,10 +175,11 @@ class Builder {
   using Handler = void (Builder::*)(const TfjsNode&);
   static const std::map<std::string, Handler, std::less<>>& handlers();
 
-  Builder(const TfjsModel& model, std::span<const std::string> outputs,
-          std::span<const std::int64_t> input_shape, bool nchw_input)
+  Builder(const TfjsModel& model, const GraphCut& cut, std::span<const std::int64_t> input_shape,
+          bool nchw_input)
       : model_(model),
-        outputs_(outputs.begin(), outputs.end()),
+        outputs_(cut.outputs),
+        input_node_(cut.input),
         input_shape_(input_shape.begin(), input_shape.end()),
         nchw_input_(nchw_input) {
     for (const TfjsNode& n : model.nodes) by_name_[n.name] = &n;
@@ -242,6 +243,7 @@ class Builder {
 
   const TfjsModel& model_;
   std::vector<std::string> outputs_;
+  std::string input_node_;
   std::vector<std::int64_t> input_shape_;
   bool nchw_input_;
   std::unordered_map<std::string, const TfjsNode*> by_name_;
@@ -328,7 +330,7 @@ std::vector<const TfjsNode*> Builder::topological_order() const {
     push(tfjs_base_name(output));
     while (!stack.empty()) {
       auto& [node, next] = stack.back();
-      if (next < node->inputs.size()) {
+      if (next < node->inputs.size() && node->name != input_node_) {
         const std::string& input = node->inputs[next++];
         if (!input.empty() && input.front() == '^') continue;  // control edges carry no data
         push(tfjs_base_name(input));
@@ -1411,6 +1413,10 @@ BuiltGraph Builder::build() {
   plan_bias_folds(order);
   for (const TfjsNode* n : order) {
     try {
+      if (n->name == input_node_) {
+        op_placeholder(*n);
+        continue;
+      }
       const auto handler = handlers().find(n->op);
       if (handler == handlers().end()) throw Unsupported("operation " + n->op);
       (this->*handler->second)(*n);
@@ -1462,34 +1468,38 @@ std::vector<std::int64_t> Layout::logical_shape() const {
   return shape;
 }
 
-BuiltGraph build_subgraph(const TfjsModel& model, std::span<const std::string> outputs,
+BuiltGraph build_subgraph(const TfjsModel& model, const GraphCut& cut,
                           std::span<const std::int64_t> input_shape) {
   try {
-    return Builder(model, outputs, input_shape, false).build();
+    return Builder(model, cut, input_shape, false).build();
   } catch (const NeedsTranspose&) {
-    return Builder(model, outputs, input_shape, true).build();
+    return Builder(model, cut, input_shape, true).build();
   }
 }
 
-const TfjsNode& input_placeholder(const TfjsModel& model, std::span<const std::string> outputs) {
-  const std::set<std::string> keep = tfjs_ancestors(model, outputs);
-  const TfjsNode* found = nullptr;
+GraphCut make_cut(const TfjsModel& model, std::span<const std::string> outputs,
+                  const std::string& requested_input) {
+  const std::string input_node = tfjs_resolve(model, requested_input);
+  GraphCut cut{{outputs.begin(), outputs.end()}, input_node};
+  const std::set<std::string> keep = tfjs_ancestors(model, outputs, input_node);
+  if (!input_node.empty() && !keep.contains(input_node))
+    fail_model(model.file, "the outputs do not depend on the input node '" + input_node + "'");
   for (const TfjsNode& n : model.nodes) {
-    if (n.op != "Placeholder" || !keep.contains(n.name)) continue;
-    if (found)
-      fail_model(model.file, "the outputs need two inputs ('" + found->name + "', '" + n.name +
+    if (n.op != "Placeholder" || !keep.contains(n.name) || n.name == input_node) continue;
+    if (!cut.input.empty())
+      fail_model(model.file, "the outputs need two inputs ('" + cut.input + "', '" + n.name +
                                  "'); the runtime feeds one");
-    found = &n;
+    cut.input = n.name;
   }
-  if (!found) fail_model(model.file, "the outputs depend on no input placeholder");
-  return *found;
+  if (cut.input.empty()) fail_model(model.file, "the outputs depend on no input placeholder");
+  return cut;
 }
 
-void check_supported(const TfjsModel& model, std::span<const std::string> outputs) {
-  const std::set<std::string> keep = tfjs_ancestors(model, outputs);
+void check_supported(const TfjsModel& model, const GraphCut& cut) {
+  const std::set<std::string> keep = tfjs_ancestors(model, cut.outputs, cut.input);
   std::map<std::string, std::string> refused;  // what -> first node
   for (const TfjsNode& n : model.nodes) {
-    if (!keep.contains(n.name)) continue;
+    if (!keep.contains(n.name) || n.name == cut.input) continue;
     if (!Builder::handlers().contains(n.op)) {
       refused.try_emplace(n.op, n.name);
       continue;

@@ -50,17 +50,24 @@ struct BuiltGraph {
   std::deque<std::vector<float>> arena;
 };
 
+// Which part of the model runs: from `input` (a node fed from outside: the placeholder, or a
+// node cut there) to `outputs`.
+struct GraphCut {
+  std::vector<std::string> outputs;
+  std::string input;
+};
+
+// The cut for `outputs`, fed at `input_node` or, when empty, at the one placeholder they need.
+GraphCut make_cut(const TfjsModel& model, std::span<const std::string> outputs,
+                  const std::string& input_node);
+
 // The ops the builder converts: fails naming every op (and a node using it) it does not, and
 // fused ops or attributes outside what it handles.
-void check_supported(const TfjsModel& model, std::span<const std::string> outputs);
+void check_supported(const TfjsModel& model, const GraphCut& cut);
 
-// Builds the subgraph for `input_shape` (the placeholder's shape with every size known). Throws
-// std::invalid_argument when the shape does not fit the graph (naming the node), ModelError for
-// what the builder cannot express.
-BuiltGraph build_subgraph(const TfjsModel& model, std::span<const std::string> outputs,
+// Builds the subgraph for `input_shape` (every size known). Throws std::invalid_argument when the
+// shape does not fit the graph (naming the node), ModelError for what the builder cannot express.
+BuiltGraph build_subgraph(const TfjsModel& model, const GraphCut& cut,
                           std::span<const std::int64_t> input_shape);
-
-// The input placeholder of the graph that leads to `outputs` (exactly one, float or int32).
-const TfjsNode& input_placeholder(const TfjsModel& model, std::span<const std::string> outputs);
 
 }  // namespace mocap::detect::xnn

@@ -74,19 +74,21 @@ std::size_t count(const std::vector<std::size_t>& dims) {
 class XnnpackRunner : public GraphRunner {
  public:
   XnnpackRunner(std::shared_ptr<const TfjsModel> model, std::span<const std::string> outputs,
-                int threads)
-      : model_(std::move(model)), outputs_(outputs.begin(), outputs.end()) {
-    xnn::check_supported(*model_, outputs_);
-    const TfjsNode& input = xnn::input_placeholder(*model_, outputs_);
-    if (const TfjsAttr* shape = input.find("shape"); shape && !shape->unknown_rank)
-      declared_shape_ = shape->shape;
+                const RunnerOptions& options)
+      : model_(std::move(model)), cut_(xnn::make_cut(*model_, outputs, options.input_node)) {
+    xnn::check_supported(*model_, cut_);
+    const int threads = options.threads;
+    for (const TfjsNode& n : model_->nodes)
+      if (n.name == cut_.input && n.op == "Placeholder")
+        if (const TfjsAttr* shape = n.find("shape"); shape && !shape->unknown_rank)
+          declared_shape_ = shape->shape;
     if (threads != 1) {
       pool_.reset(pthreadpool_create(threads > 1 ? static_cast<std::size_t>(threads) : 0));
       if (!pool_) throw std::runtime_error("could not start the XNNPACK thread pool");
     }
   }
 
-  void run(const TensorView& input, std::vector<Tensor>& outputs) override {
+  void run(const GraphTensorView& input, std::vector<GraphTensor>& outputs) override {
     check_input(input);
     Compiled& c = compiled_for(input.shape);
     if (is_row_major(c.graph.input_layout))
@@ -98,7 +100,7 @@ class XnnpackRunner : public GraphRunner {
     outputs.resize(c.outputs.size());
     for (std::size_t i = 0; i < c.outputs.size(); ++i) {
       const xnn::Layout& layout = c.graph.output_layouts[i];
-      Tensor& out = outputs[i];
+      GraphTensor& out = outputs[i];
       out.shape = layout.logical_shape();
       out.values.resize(count(layout.physical));
       if (is_row_major(layout))
@@ -120,7 +122,7 @@ class XnnpackRunner : public GraphRunner {
     std::vector<std::vector<float>> outputs;
   };
 
-  void check_input(const TensorView& input) const {
+  void check_input(const GraphTensorView& input) const {
     std::size_t size = 1;
     for (const std::int64_t d : input.shape) {
       if (d <= 0 || d > (1 << 20))
@@ -157,7 +159,7 @@ class XnnpackRunner : public GraphRunner {
     }
     Compiled c;
     c.shape.assign(shape.begin(), shape.end());
-    c.graph = xnn::build_subgraph(*model_, outputs_, shape);
+    c.graph = xnn::build_subgraph(*model_, cut_, shape);
     xnn_runtime_t runtime = nullptr;
     if (xnn_create_runtime_v2(c.graph.subgraph.get(), pool_.get(), 0, &runtime) !=
         xnn_status_success)
@@ -178,7 +180,7 @@ class XnnpackRunner : public GraphRunner {
   }
 
   std::shared_ptr<const TfjsModel> model_;
-  std::vector<std::string> outputs_;
+  xnn::GraphCut cut_;
   std::vector<std::int64_t> declared_shape_;  // the placeholder's, -1 for free sizes
   std::unique_ptr<pthreadpool, PoolDeleter> pool_;
   std::list<Compiled> cache_;
@@ -195,8 +197,8 @@ bool initialise_xnnpack() {
 
 std::unique_ptr<GraphRunner> make_xnnpack_runner(std::shared_ptr<const TfjsModel> model,
                                                  std::span<const std::string> outputs,
-                                                 int threads) {
-  return std::make_unique<XnnpackRunner>(std::move(model), outputs, threads);
+                                                 const RunnerOptions& options) {
+  return std::make_unique<XnnpackRunner>(std::move(model), outputs, options);
 }
 
 }  // namespace mocap::detect

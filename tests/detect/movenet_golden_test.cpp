@@ -55,8 +55,11 @@ class MovenetGolden : public ::testing::TestWithParam<Backend> {
     if (GetParam() == Backend::xnnpack && !xnnpack_available())
       GTEST_SKIP() << "this build has no XNNPACK runtime";
     auto& network = networks_[GetParam()];
-    if (!network)
-      network = std::make_unique<MovenetNetwork>(model_json_, RunnerOptions{GetParam()});
+    if (!network) {
+      RunnerOptions options;
+      options.backend = GetParam();
+      network = std::make_unique<MovenetNetwork>(model_json_, options);
+    }
     network_ = network.get();
   }
 
