@@ -1,5 +1,6 @@
-// detect.movenet in a graph: video frames in, COCO-17 people out with the frames' headers; a
-// missing model or a bad input size stops the graph with an error naming the node and the fix.
+// detect.movenet in a graph: video frames in, COCO-17 people out with the frames' headers, also
+// from several workers on both runtimes (in frame order, none lost); a missing model, a bad input
+// size or an unknown runtime stops the graph with an error naming the node and the fix.
 
 #include <gtest/gtest.h>
 
@@ -10,6 +11,7 @@
 
 #include <opencv2/imgcodecs.hpp>
 
+#include "detect/graph_runner.hpp"
 #include "detect/model_files.hpp"
 #include "graph/registry.hpp"
 #include "sink_test_util.hpp"
@@ -67,11 +69,11 @@ class CapturePeople2D : public Node {
 };
 MOCAP_REGISTER_NODE("unit.capture_people2d", CapturePeople2D)
 
-std::string graph_yaml(const std::string& detector_params) {
+std::string graph_yaml(const std::string& detector_params, int frames = 2) {
   return R"(
 nodes:
   src: { type: unit.image_file, params: { path: )" +
-         kFrame.string() + R"(, count: 2 } }
+         kFrame.string() + ", count: " + std::to_string(frames) + R"( } }
   det: { type: detect.movenet, params: { )" +
          detector_params + R"( } }
   out: { type: unit.capture_people2d }
@@ -89,7 +91,7 @@ TEST(MovenetNode, SendsCoco17PeopleInFramePixelsWithTheFrameHeaders) {
   }
   if (!fs::exists(kFrame)) GTEST_SKIP() << "reference frame absent: " << kFrame;
   captured.clear();
-  const RunResult result = testing::run_graph(graph_yaml("input_size: 512, min_person_score: 0.2"));
+  const RunResult result = testing::run_graph(graph_yaml("input_size: 512, min_person_score: 0.2, warm_up: false"));
   ASSERT_TRUE(result.ok) << result.error;
   ASSERT_EQ(captured.size(), 2u);
   for (std::size_t i = 0; i < captured.size(); ++i) {
@@ -105,6 +107,49 @@ TEST(MovenetNode, SendsCoco17PeopleInFramePixelsWithTheFrameHeaders) {
       EXPECT_LT(p.box.height, 150.0f);
     }
   }
+}
+
+// Two copies on alternate frames, each runtime: every frame's people, in frame order, the same
+// as one copy finds.
+TEST(MovenetNode, WorkersKeepFrameOrderAndLoseNothingOnBothRuntimes) {
+  try {
+    detect::movenet_model_json();
+  } catch (const detect::ModelMissing& e) {
+    GTEST_SKIP() << e.what();
+  }
+  if (!fs::exists(kFrame)) GTEST_SKIP() << "reference frame absent: " << kFrame;
+  for (const std::string backend : {"opencv", "xnnpack"}) {
+    if (backend == "xnnpack" && !detect::xnnpack_available()) continue;
+    SCOPED_TRACE(backend);
+    captured.clear();
+    const RunResult result = testing::run_graph(
+        graph_yaml("input_size: 256, min_person_score: 0.05, warm_up: false, workers: 2, "
+                   "backend: " +
+                       backend,
+                   7));
+    ASSERT_TRUE(result.ok) << result.error;
+    ASSERT_EQ(captured.size(), 7u);
+    for (std::size_t i = 0; i < captured.size(); ++i) {
+      EXPECT_EQ(captured[i].header.frame, static_cast<std::int64_t>(i));
+      EXPECT_EQ(captured[i].header.capture_ns, 1000 + static_cast<std::int64_t>(i));
+      ASSERT_EQ(captured[i].people.size(), captured[0].people.size());
+      ASSERT_FALSE(captured[i].people.empty());
+      EXPECT_FLOAT_EQ(captured[i].people[0].box.x, captured[0].people[0].box.x);
+    }
+  }
+}
+
+TEST(MovenetNode, AnUnknownRuntimeStopsTheGraphNamingTheChoices) {
+  try {
+    detect::movenet_model_json();
+  } catch (const detect::ModelMissing& e) {
+    GTEST_SKIP() << e.what();
+  }
+  if (!fs::exists(kFrame)) GTEST_SKIP() << "reference frame absent: " << kFrame;
+  const RunResult result = testing::run_graph(graph_yaml("backend: tflite"));
+  ASSERT_FALSE(result.ok);
+  EXPECT_NE(result.error.find("'det'"), std::string::npos) << result.error;
+  EXPECT_NE(result.error.find("auto, xnnpack or opencv"), std::string::npos) << result.error;
 }
 
 TEST(MovenetNode, AMissingModelStopsTheGraphNamingTheSetupCommand) {
