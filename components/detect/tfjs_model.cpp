@@ -152,18 +152,16 @@ TfjsWeight read_weight(const json& spec, std::string_view data, std::size_t& off
   return w;
 }
 
+// `data`: every weight file of the manifest, concatenated in manifest order.
 std::unordered_map<std::string, TfjsWeight> read_weights(const json& manifest,
+                                                         std::string_view data,
                                                          const std::filesystem::path& model) {
   std::unordered_map<std::string, TfjsWeight> weights;
-  for (const json& group : manifest) {
-    std::string data;
-    for (const json& path : group.at("paths"))
-      data += read_file(model.parent_path() / path.get<std::string>(), model);
-    std::size_t offset = 0;
+  std::size_t offset = 0;
+  for (const json& group : manifest)
     for (const json& spec : group.at("weights"))
       weights[spec.at("name")] = read_weight(spec, data, offset, model);
-    if (offset != data.size()) fail_model(model, "weight files longer than their manifest");
-  }
+  if (offset != data.size()) fail_model(model, "weight files longer than their manifest");
   return weights;
 }
 
@@ -212,6 +210,44 @@ void bypass_batch_of_one_noops(TfjsModel& model) {
   for (const auto& [name, target] : replacement) model.bypassed[name] = resolve(target);
 }
 
+json parse_json(std::string_view text, const std::filesystem::path& name) {
+  json model;
+  try {
+    model = json::parse(text);
+  } catch (const json::exception& e) {
+    fail_model(name, std::string("not valid JSON: ") + e.what());
+  }
+  if (!model.is_object() || !model.contains("modelTopology") || !model.contains("weightsManifest"))
+    fail_model(name, "not a TF.js graph model (no modelTopology or weightsManifest)");
+  return model;
+}
+
+// Runs `f`, giving errors that do not name the file yet (JSON structure, numbers, data types) its
+// name.
+template <class F>
+auto naming(const std::filesystem::path& name, F f) {
+  try {
+    return f();
+  } catch (const ModelError&) {
+    throw;
+  } catch (const std::exception& e) {
+    fail_model(name, e.what());
+  }
+}
+
+TfjsModel build_model(const json& model, std::string_view weights,
+                      const std::filesystem::path& name) {
+  return naming(name, [&] {
+    TfjsModel out;
+    out.file = name;
+    out.nodes = read_nodes(model.at("modelTopology"));
+    out.weights = read_weights(model.at("weightsManifest"), weights, name);
+    out.producer = model["modelTopology"].value("versions", json::object()).value("producer", 808);
+    bypass_batch_of_one_noops(out);
+    return out;
+  });
+}
+
 }  // namespace
 
 void fail_model(const std::filesystem::path& file, const std::string& what) {
@@ -224,27 +260,20 @@ const TfjsAttr* TfjsNode::find(std::string_view key) const {
 }
 
 TfjsModel read_tfjs_model(const std::filesystem::path& model_json) {
-  json model;
-  try {
-    model = json::parse(read_file(model_json, model_json));
-  } catch (const json::exception& e) {
-    fail_model(model_json, std::string("not valid JSON: ") + e.what());
-  }
-  if (!model.is_object() || !model.contains("modelTopology") || !model.contains("weightsManifest"))
-    fail_model(model_json, "not a TF.js graph model (no modelTopology or weightsManifest)");
-  try {
-    TfjsModel out;
-    out.file = model_json;
-    out.nodes = read_nodes(model["modelTopology"]);
-    out.weights = read_weights(model["weightsManifest"], model_json);
-    out.producer = model["modelTopology"].value("versions", json::object()).value("producer", 808);
-    bypass_batch_of_one_noops(out);
-    return out;
-  } catch (const ModelError&) {
-    throw;
-  } catch (const std::exception& e) {  // JSON structure, numbers, data types
-    fail_model(model_json, e.what());
-  }
+  const json model = parse_json(read_file(model_json, model_json), model_json);
+  const std::string weights = naming(model_json, [&] {
+    std::string data;
+    for (const json& group : model.at("weightsManifest"))
+      for (const json& path : group.at("paths"))
+        data += read_file(model_json.parent_path() / path.get<std::string>(), model_json);
+    return data;
+  });
+  return build_model(model, weights, model_json);
+}
+
+TfjsModel parse_tfjs_model(std::string_view model_json, std::string_view weights,
+                           const std::filesystem::path& name) {
+  return build_model(parse_json(model_json, name), weights, name);
 }
 
 std::string tfjs_resolve(const TfjsModel& model, const std::string& name) {

@@ -75,6 +75,10 @@ struct TfjsModel {
 // Throws ModelError for an unreadable file, JSON that is not a TF.js graph model, weight files
 // shorter or longer than their manifest, or weights of a type it does not read.
 TfjsModel read_tfjs_model(const std::filesystem::path& model_json);
+// The same from memory: model.json's text and its weight files concatenated in manifest order;
+// `name` is what errors call it.
+TfjsModel parse_tfjs_model(std::string_view model_json, std::string_view weights,
+                           const std::filesystem::path& name);
 
 // The outputs and every node they depend on, up to `input_node` (fed from outside: its own inputs
 // are not needed; empty: none). Throws ModelError for a name the graph lacks.

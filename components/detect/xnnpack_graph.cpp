@@ -16,6 +16,9 @@ namespace mocap::detect::xnn {
 namespace {
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
+constexpr double kLargestIndex = 1 << 30;  // sizes, indices and axes beyond are garbage
+constexpr std::size_t kLargestTensor = 1
+                                       << 28;  // values (1 GiB): a network needing more is refused
 
 // A value known when the subgraph is built (weights, shape arithmetic), folded on the host.
 // Integers and float32 are both exact in a double.
@@ -206,7 +209,12 @@ class Builder {
   std::uint32_t define_tensor(std::span<const std::size_t> dims, const float* data = nullptr,
                               std::uint32_t flags = 0);
   std::uint32_t define_static(std::vector<float> data, std::span<const std::size_t> dims);
-  void check(xnn_status status, const TfjsNode& n, const char* what) const;
+  // Queues an XNNPACK node: build() defines the nodes whose output is used (XNNPACK 2022 does not
+  // prune dead nodes and would leave their outputs without memory).
+  using Define = std::function<xnn_status(xnn_subgraph_t)>;
+  void emit(const TfjsNode& n, std::string what, std::vector<std::uint32_t> inputs,
+            std::uint32_t output, Define define);
+  void define_live_nodes();
   std::uint32_t nhwc(const Tensor& t, const TfjsNode& n);
   Tensor copy_to(const Tensor& t, std::span<const std::int64_t> shape, const TfjsNode& n);
   std::uint32_t const_in_frame(const Const& c, const Layout& frame);
@@ -251,6 +259,15 @@ class Builder {
   std::unordered_map<std::string, std::string> bias_of_conv_;  // conv node -> bias Const node
   std::unordered_map<std::string, std::string> folded_add_;    // Add node -> its conv node
   std::unordered_map<std::string, Value> values_;              // "node:output" -> value
+  struct Pending {
+    const TfjsNode* node;
+    std::string what;
+    std::vector<std::uint32_t> inputs;
+    std::uint32_t output;
+    Define define;
+  };
+  std::vector<Pending> pending_;
+  std::vector<std::uint32_t> external_outputs_;
   BuiltGraph out_;
 };
 
@@ -406,7 +423,12 @@ const Tensor* Builder::tensor_or_null(const TfjsNode& n, std::size_t input) cons
 std::vector<std::int64_t> Builder::ints(const TfjsNode& n, std::size_t input) const {
   const Const& c = constant(n, input);
   std::vector<std::int64_t> out;
-  for (const double v : c.v) out.push_back(static_cast<std::int64_t>(v));
+  for (const double v : c.v) {
+    if (!(std::fabs(v) < kLargestIndex))
+      throw ShapeMismatch("input " + std::to_string(input) + " holds " + std::to_string(v) +
+                          ", not a size, index or axis");
+    out.push_back(static_cast<std::int64_t>(v));
+  }
   return out;
 }
 
@@ -417,14 +439,39 @@ std::vector<std::int64_t> Builder::logical_shape(const Value& v) const {
 
 // ---- subgraph helpers -------------------------------------------------------------------------
 
-void Builder::check(xnn_status status, const TfjsNode& n, const char* what) const {
-  if (status != xnn_status_success)
-    throw Unsupported(std::string("XNNPACK refused ") + what + " (status " +
-                      std::to_string(static_cast<int>(status)) + ") for node '" + n.name + "'");
+void Builder::emit(const TfjsNode& n, std::string what, std::vector<std::uint32_t> inputs,
+                   std::uint32_t output, Define define) {
+  pending_.push_back({&n, std::move(what), std::move(inputs), output, std::move(define)});
+}
+
+// Defines, in order, the queued nodes that lead to an external output.
+void Builder::define_live_nodes() {
+  std::set<std::uint32_t> needed(external_outputs_.begin(), external_outputs_.end());
+  std::vector<bool> live(pending_.size(), false);
+  for (std::size_t i = pending_.size(); i-- > 0;) {
+    if (!needed.contains(pending_[i].output)) continue;
+    live[i] = true;
+    needed.insert(pending_[i].inputs.begin(), pending_[i].inputs.end());
+  }
+  for (std::size_t i = 0; i < pending_.size(); ++i) {
+    if (!live[i]) continue;
+    const xnn_status status = pending_[i].define(out_.subgraph.get());
+    if (status != xnn_status_success)
+      fail_model(model_.file, "XNNPACK refused " + pending_[i].what + " (status " +
+                                  std::to_string(static_cast<int>(status)) + ") for node '" +
+                                  pending_[i].node->name + "'");
+  }
 }
 
 std::uint32_t Builder::define_tensor(std::span<const std::size_t> dims, const float* data,
                                      std::uint32_t flags) {
+  std::size_t values = 1;
+  for (const std::size_t d : dims) {
+    if (d == 0 || d > kLargestTensor || values > kLargestTensor / d)
+      throw ShapeMismatch("a tensor of " + std::to_string(d) + " x " + std::to_string(values) +
+                          " values (empty or over " + std::to_string(kLargestTensor) + ")");
+    values *= d;
+  }
   std::uint32_t id = XNN_INVALID_VALUE_ID;
   const xnn_status s = xnn_define_tensor_value(out_.subgraph.get(), xnn_datatype_fp32, dims.size(),
                                                dims.data(), data, XNN_INVALID_VALUE_ID, flags, &id);
@@ -456,8 +503,9 @@ std::uint32_t Builder::nhwc(const Tensor& t, const TfjsNode& n) {
 Tensor Builder::copy_to(const Tensor& t, std::span<const std::int64_t> shape, const TfjsNode& n) {
   std::vector<std::size_t> dims(shape.begin(), shape.end());
   Tensor out{define_tensor(dims), identity_layout(shape)};
-  check(xnn_define_static_reshape(out_.subgraph.get(), dims.size(), dims.data(), t.id, out.id, 0),
-        n, "a reshape");
+  emit(n, "a reshape", {t.id}, out.id, [dims, in = t.id, id = out.id](xnn_subgraph_t s) {
+    return xnn_define_static_reshape(s, dims.size(), dims.data(), in, id, 0);
+  });
   return out;
 }
 
@@ -500,7 +548,9 @@ std::uint32_t Builder::const_in_frame(const Const& c, const Layout& frame) {
 
 Tensor Builder::clamp(const Tensor& t, float lo, float hi, const TfjsNode& n) {
   Tensor out{define_tensor(t.layout.physical), t.layout};
-  check(xnn_define_clamp(out_.subgraph.get(), lo, hi, t.id, out.id, 0), n, "a clamp");
+  emit(n, "a clamp", {t.id}, out.id, [=, in = t.id, id = out.id](xnn_subgraph_t s) {
+    return xnn_define_clamp(s, lo, hi, in, id, 0);
+  });
   return out;
 }
 
@@ -868,16 +918,19 @@ Tensor Builder::concat_tensors(const std::vector<Tensor>& parts, std::int64_t ax
     post[p] = total - offset - t.layout.physical[p];
     offset += t.layout.physical[p];
     Tensor padded{define_tensor(layout.physical), layout};
-    check(xnn_define_static_constant_pad(out_.subgraph.get(), pre.data(), post.data(), 0.0f, t.id,
-                                         padded.id, 0),
-          n, "a padding (concatenation)");
+    emit(n, "a padding (concatenation)", {t.id}, padded.id,
+         [pre, post, in = t.id, id = padded.id](xnn_subgraph_t s) {
+           return xnn_define_static_constant_pad(s, pre.data(), post.data(), 0.0f, in, id, 0);
+         });
     if (!sum) {
       sum = padded;
       continue;
     }
     Tensor added{define_tensor(layout.physical), layout};
-    check(xnn_define_add2(out_.subgraph.get(), -kInf, kInf, sum->id, padded.id, added.id, 0), n,
-          "an addition (concatenation)");
+    emit(n, "an addition (concatenation)", {sum->id, padded.id}, added.id,
+         [a = sum->id, b = padded.id, id = added.id](xnn_subgraph_t s) {
+           return xnn_define_add2(s, -kInf, kInf, a, b, id, 0);
+         });
     sum = added;
   }
   return *sum;
@@ -954,25 +1007,25 @@ Tensor Builder::binary_tensor(const std::string& op, const Value& a, const Value
       throw Unsupported("a constant of higher rank than the tensor it combines with");
   }
   Tensor out{define_tensor(layout.physical), layout};
-  xnn_subgraph_t s = out_.subgraph.get();
-  xnn_status status;
+  const std::uint32_t id = out.id;
+  Define define;
   if (op == "Add" || op == "AddV2" || op == "BiasAdd")
-    status = xnn_define_add2(s, -kInf, kInf, ia, ib, out.id, 0);
+    define = [=](xnn_subgraph_t s) { return xnn_define_add2(s, -kInf, kInf, ia, ib, id, 0); };
   else if (op == "Sub")
-    status = xnn_define_subtract(s, -kInf, kInf, ia, ib, out.id, 0);
+    define = [=](xnn_subgraph_t s) { return xnn_define_subtract(s, -kInf, kInf, ia, ib, id, 0); };
   else if (op == "Mul")
-    status = xnn_define_multiply2(s, -kInf, kInf, ia, ib, out.id, 0);
+    define = [=](xnn_subgraph_t s) { return xnn_define_multiply2(s, -kInf, kInf, ia, ib, id, 0); };
   else if (op == "RealDiv" || op == "Div")
-    status = xnn_define_divide(s, -kInf, kInf, ia, ib, out.id, 0);
+    define = [=](xnn_subgraph_t s) { return xnn_define_divide(s, -kInf, kInf, ia, ib, id, 0); };
   else if (op == "Maximum")
-    status = xnn_define_maximum2(s, ia, ib, out.id, 0);
+    define = [=](xnn_subgraph_t s) { return xnn_define_maximum2(s, ia, ib, id, 0); };
   else if (op == "Minimum")
-    status = xnn_define_minimum2(s, ia, ib, out.id, 0);
+    define = [=](xnn_subgraph_t s) { return xnn_define_minimum2(s, ia, ib, id, 0); };
   else if (op == "SquaredDifference")
-    status = xnn_define_squared_difference(s, ia, ib, out.id, 0);
+    define = [=](xnn_subgraph_t s) { return xnn_define_squared_difference(s, ia, ib, id, 0); };
   else
     throw Unsupported(op + " of computed tensors");
-  check(status, n, op.c_str());
+  emit(n, op, {ia, ib}, id, std::move(define));
   return out;
 }
 
@@ -1021,27 +1074,23 @@ void Builder::op_unary(const TfjsNode& n) {
   if (n.op == "Relu") return set(n, clamp(t, 0.0f, kInf, n));
   if (n.op == "Relu6") return set(n, clamp(t, 0.0f, 6.0f, n));
   Tensor out{define_tensor(t.layout.physical), t.layout};
-  xnn_subgraph_t s = out_.subgraph.get();
-  xnn_status status;
+  using Unary = xnn_status (*)(xnn_subgraph_t, std::uint32_t, std::uint32_t, std::uint32_t);
+  static const std::map<std::string, Unary, std::less<>> kUnary = {
+      {"Sigmoid", xnn_define_sigmoid},  {"Abs", xnn_define_abs},
+      {"Neg", xnn_define_negate},       {"Square", xnn_define_square},
+      {"Sqrt", xnn_define_square_root}, {"Floor", xnn_define_floor},
+      {"Ceil", xnn_define_ceiling}};
+  const std::uint32_t from = t.id, id = out.id;
+  Define define;
   if (n.op == "LeakyRelu")
-    status = xnn_define_leaky_relu(s, alpha, t.id, out.id, 0);
-  else if (n.op == "Sigmoid")
-    status = xnn_define_sigmoid(s, t.id, out.id, 0);
+    define = [=](xnn_subgraph_t s) { return xnn_define_leaky_relu(s, alpha, from, id, 0); };
   else if (n.op == "Elu")
-    status = xnn_define_elu(s, 1.0f, t.id, out.id, 0);
-  else if (n.op == "Abs")
-    status = xnn_define_abs(s, t.id, out.id, 0);
-  else if (n.op == "Neg")
-    status = xnn_define_negate(s, t.id, out.id, 0);
-  else if (n.op == "Square")
-    status = xnn_define_square(s, t.id, out.id, 0);
-  else if (n.op == "Sqrt")
-    status = xnn_define_square_root(s, t.id, out.id, 0);
-  else if (n.op == "Floor")
-    status = xnn_define_floor(s, t.id, out.id, 0);
+    define = [=](xnn_subgraph_t s) { return xnn_define_elu(s, 1.0f, from, id, 0); };
+  else if (const auto f = kUnary.find(n.op); f != kUnary.end())
+    define = [=, f = f->second](xnn_subgraph_t s) { return f(s, from, id, 0); };
   else
-    status = xnn_define_ceiling(s, t.id, out.id, 0);
-  check(status, n, n.op.c_str());
+    throw Unsupported("unary op " + n.op);
+  emit(n, n.op, {from}, id, std::move(define));
   set(n, out);
 }
 
@@ -1152,23 +1201,27 @@ void Builder::op_conv(const TfjsNode& n) {
   const std::uint32_t bias_id = define_static(std::move(bias), bias_dims);
   const std::uint32_t flags = p.same ? XNN_FLAG_TENSORFLOW_SAME_PADDING : 0;
   const auto u = [](std::int64_t v) { return static_cast<std::uint32_t>(v); };
+  const std::uint32_t id = out.id;
   if (depthwise) {
-    check(xnn_define_depthwise_convolution_2d(out_.subgraph.get(), 0, 0, 0, 0, u(kh), u(kw),
-                                              u(p.stride_h), u(p.stride_w), u(p.dilation_h),
-                                              u(p.dilation_w), u(ko), static_cast<std::size_t>(ki),
-                                              lo, hi, in, filter_id, bias_id, out.id, flags),
-          n, "a depthwise convolution");
+    emit(n, "a depthwise convolution", {in}, id, [=](xnn_subgraph_t s) {
+      return xnn_define_depthwise_convolution_2d(s, 0, 0, 0, 0, u(kh), u(kw), u(p.stride_h),
+                                                 u(p.stride_w), u(p.dilation_h), u(p.dilation_w),
+                                                 u(ko), static_cast<std::size_t>(ki), lo, hi, in,
+                                                 filter_id, bias_id, id, flags);
+    });
   } else {
-    check(xnn_define_convolution_2d(
-              out_.subgraph.get(), 0, 0, 0, 0, u(kh), u(kw), u(p.stride_h), u(p.stride_w),
-              u(p.dilation_h), u(p.dilation_w), u(groups), static_cast<std::size_t>(ki),
-              static_cast<std::size_t>(ko / groups), lo, hi, in, filter_id, bias_id, out.id, flags),
-          n, "a convolution");
+    emit(n, "a convolution", {in}, id, [=](xnn_subgraph_t s) {
+      return xnn_define_convolution_2d(
+          s, 0, 0, 0, 0, u(kh), u(kw), u(p.stride_h), u(p.stride_w), u(p.dilation_h),
+          u(p.dilation_w), u(groups), static_cast<std::size_t>(ki),
+          static_cast<std::size_t>(ko / groups), lo, hi, in, filter_id, bias_id, id, flags);
+    });
   }
   if (leaky) {
     Tensor activated{define_tensor(out.layout.physical), out.layout};
-    check(xnn_define_leaky_relu(out_.subgraph.get(), leaky_alpha, out.id, activated.id, 0), n,
-          "a leaky ReLU");
+    emit(n, "a leaky ReLU", {id}, activated.id, [=, to = activated.id](xnn_subgraph_t s) {
+      return xnn_define_leaky_relu(s, leaky_alpha, id, to, 0);
+    });
     out = activated;
   }
   set(n, out);
@@ -1192,10 +1245,11 @@ void Builder::op_max_pool(const TfjsNode& n) {
   Tensor out{define_tensor(std::vector<std::size_t>(out_shape.begin(), out_shape.end())),
              identity_layout(out_shape)};
   const auto u = [](std::int64_t v) { return static_cast<std::uint32_t>(v); };
-  check(xnn_define_max_pooling_2d(out_.subgraph.get(), 0, 0, 0, 0, u(kh), u(kw), u(p.stride_h),
-                                  u(p.stride_w), 1, 1, -kInf, kInf, in, out.id,
-                                  p.same ? XNN_FLAG_TENSORFLOW_SAME_PADDING : 0),
-        n, "a max pooling");
+  emit(n, "a max pooling", {in}, out.id, [=, id = out.id](xnn_subgraph_t s) {
+    return xnn_define_max_pooling_2d(s, 0, 0, 0, 0, u(kh), u(kw), u(p.stride_h), u(p.stride_w), 1,
+                                     1, -kInf, kInf, in, id,
+                                     p.same ? XNN_FLAG_TENSORFLOW_SAME_PADDING : 0);
+  });
   set(n, out);
 }
 
@@ -1216,9 +1270,10 @@ void Builder::op_mean(const TfjsNode& n) {
   Layout layout = l;
   layout.physical[1] = layout.physical[2] = 1;
   Tensor out{define_tensor(layout.physical), layout};
-  check(
-      xnn_define_global_average_pooling_2d(out_.subgraph.get(), -kInf, kInf, input->id, out.id, 0),
-      n, "a global average pooling");
+  emit(n, "a global average pooling", {input->id}, out.id,
+       [in = input->id, id = out.id](xnn_subgraph_t s) {
+         return xnn_define_global_average_pooling_2d(s, -kInf, kInf, in, id, 0);
+       });
   Value v = out;
   const TfjsAttr* keep = n.find("keep_dims");
   if (!keep || !keep->b) {
@@ -1254,9 +1309,10 @@ void Builder::op_pad(const TfjsNode& n) {
     layout.physical[p] += pre[p] + post[p];
   }
   Tensor out{define_tensor(layout.physical), layout};
-  check(xnn_define_static_constant_pad(out_.subgraph.get(), pre.data(), post.data(), fill,
-                                       input->id, out.id, 0),
-        n, "a padding");
+  emit(n, "a padding", {input->id}, out.id,
+       [pre, post, fill, in = input->id, id = out.id](xnn_subgraph_t s) {
+         return xnn_define_static_constant_pad(s, pre.data(), post.data(), fill, in, id, 0);
+       });
   set(n, out);
 }
 
@@ -1279,9 +1335,11 @@ void Builder::op_resize_bilinear(const TfjsNode& n) {
   const std::vector<std::int64_t> out_shape = {in_shape[0], size[0], size[1], in_shape[3]};
   Tensor out{define_tensor(std::vector<std::size_t>(out_shape.begin(), out_shape.end())),
              identity_layout(out_shape)};
-  check(xnn_define_static_resize_bilinear_2d(out_.subgraph.get(), static_cast<std::size_t>(size[0]),
-                                             static_cast<std::size_t>(size[1]), in, out.id, flags),
-        n, "a bilinear resize");
+  emit(n, "a bilinear resize", {in}, out.id,
+       [in, flags, h = static_cast<std::size_t>(size[0]), w = static_cast<std::size_t>(size[1]),
+        id = out.id](xnn_subgraph_t s) {
+         return xnn_define_static_resize_bilinear_2d(s, h, w, in, id, flags);
+       });
   set(n, out);
 }
 
@@ -1335,9 +1393,11 @@ void Builder::op_split(const TfjsNode& n) {
     Layout layout = l;
     layout.physical[3] = size;
     Tensor out{define_tensor(layout.physical), layout};
-    check(xnn_define_convolution_2d(out_.subgraph.get(), 0, 0, 0, 0, 1, 1, 1, 1, 1, 1, 1, channels,
-                                    size, -kInf, kInf, input->id, filter, bias, out.id, 0),
-          n, "a channel selection");
+    emit(n, "a channel selection", {input->id}, out.id,
+         [=, in = input->id, id = out.id](xnn_subgraph_t s) {
+           return xnn_define_convolution_2d(s, 0, 0, 0, 0, 1, 1, 1, 1, 1, 1, 1, channels, size,
+                                            -kInf, kInf, in, filter, bias, id, 0);
+         });
     set(n, out, static_cast<int>(k));
   }
 }
@@ -1445,13 +1505,16 @@ BuiltGraph Builder::build() {
     // before anyone knew it would be one).
     const std::uint32_t id =
         define_tensor(t->layout.physical, nullptr, XNN_VALUE_FLAG_EXTERNAL_OUTPUT);
-    const auto& dims = t->layout.physical;
-    if (xnn_define_static_reshape(out_.subgraph.get(), dims.size(), dims.data(), t->id, id, 0) !=
-        xnn_status_success)
-      fail_model(model_.file, "XNNPACK refused the copy of output '" + output + "'");
+    const TfjsNode& node = *by_name_.at(tfjs_base_name(output));
+    emit(node, "the copy of output '" + output + "'", {t->id}, id,
+         [dims = t->layout.physical, in = t->id, id](xnn_subgraph_t s) {
+           return xnn_define_static_reshape(s, dims.size(), dims.data(), in, id, 0);
+         });
+    external_outputs_.push_back(id);
     out_.output_ids.push_back(id);
     out_.output_layouts.push_back(t->layout);
   }
+  define_live_nodes();
   return std::move(out_);
 }
 

@@ -125,13 +125,15 @@ class XnnpackRunner : public GraphRunner {
   void check_input(const GraphTensorView& input) const {
     std::size_t size = 1;
     for (const std::int64_t d : input.shape) {
-      if (d <= 0 || d > (1 << 20))
-        throw std::invalid_argument("network input dimension " + std::to_string(d));
+      if (d <= 0 || d > (1 << 20) || size > (std::size_t{1} << 28) / static_cast<std::size_t>(d))
+        throw std::invalid_argument("input dimension " + std::to_string(d) + " for " +
+                                    model_->file.string() + " (empty or too large)");
       size *= static_cast<std::size_t>(d);
     }
     if (size != input.values.size())
-      throw std::invalid_argument("network input has " + std::to_string(input.values.size()) +
-                                  " values for a shape of " + std::to_string(size));
+      throw std::invalid_argument("input of " + std::to_string(input.values.size()) +
+                                  " values for a shape of " + std::to_string(size) + " to " +
+                                  model_->file.string());
     if (declared_shape_.empty()) return;
     bool fits = declared_shape_.size() == input.shape.size();
     for (std::size_t a = 0; fits && a < input.shape.size(); ++a)

@@ -9,6 +9,7 @@
 // Prints Markdown tables. A probe node in this program records what reaches the outputs.
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -166,6 +167,8 @@ struct RunSpec {
   int size = 256;
   bool live = false;
   int detector_threads = 0;
+  std::string backend = "auto";
+  int workers = 1;
   int lag = 8;
 };
 
@@ -176,7 +179,8 @@ std::string graph_text(const RunSpec& s, const video::VideoSource& info, const s
     << "  src: { type: source.video, params: { path: \"" << s.video
     << "\", mode: " << (s.live ? "live" : "offline") << " } }\n"
     << "  det: { type: detect.movenet, params: { input_size: " << s.size
-    << ", threads: " << s.detector_threads << " } }\n"
+    << ", threads: " << s.detector_threads << ", backend: " << s.backend
+    << ", workers: " << s.workers << " } }\n"
     << "  track: { type: recon.tracker }\n"
     << "  scale: { type: recon.scaler, params: { db: \"" << s.db << "\" } }\n"
     << "  match: { type: recon.matcher, params: { db: \"" << s.db << "\", k: 32, probe: 16 } }\n"
@@ -277,6 +281,17 @@ std::vector<std::string> split(const std::string& list) {
   return out;
 }
 
+// Every runtime x workers x threads x mode of the options, in that order.
+std::vector<std::array<std::string, 4>> matrix(const cli::Args& args) {
+  std::vector<std::array<std::string, 4>> out;
+  for (const std::string& backend : split(args.get("backends")))
+    for (const std::string& workers : split(args.get("workers")))
+      for (const std::string& threads : split(args.get("threads")))
+        for (const std::string& mode : split(args.get("modes")))
+          out.push_back({backend, workers, threads, mode});
+  return out;
+}
+
 }  // namespace
 }  // namespace mocap::bench
 
@@ -291,40 +306,47 @@ int main(int argc, char** argv) {
       .option("sizes", "LIST", "MoveNet input sizes", "256,384")
       .option("db", "FILE", "pose database", "build/db/cmu31_train.mdb")
       .option("modes", "LIST", "offline, live or both", "offline,live")
-      .option("threads", "N", "detector threads (0: OpenCV's default)", "0")
+      .option("threads", "LIST", "detector threads per worker (0: the runtime's default)", "0")
+      .option("backends", "LIST", "detector runtimes: auto, xnnpack, opencv", "auto")
+      .option("workers", "LIST", "detector workers (copies on consecutive frames)", "1")
       .option("lag", "N", "temporal selection look-ahead in frames", "8")
       .option("out", "DIR", "where each run's outputs go", "/tmp/mocap-bench-video");
   int exit_code = 0;
   if (!args.parse(argc - 1, argv + 1, exit_code)) return exit_code;
   try {
     std::cout
-        << "| video | size | mode | frames | 3D outputs | wall s | fps | people/frame (max) "
+        << "| video | size | runtime | workers | threads | mode | frames | 3D outputs | wall s | "
+           "fps | people/frame (max) "
            "| 3D people/frame | tracks | tracks > 50 | id breaks | id jumps | latency p50 "
            "ms | p95 ms | p50 first / last quarter ms | src skips | det drops | det p50 ms |\n"
-        << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+        << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+           "---|\n";
     for (const std::string& video : split(args.get("videos"))) {
       if (!std::filesystem::exists(video)) {
         std::cout << "| " << video << " | absent, skipped |\n";
         continue;
       }
       for (const std::string& size : split(args.get("sizes"))) {
-        for (const std::string& mode : split(args.get("modes"))) {
+        for (const auto& [backend, workers, threads, mode] : matrix(args)) {
           RunSpec spec;
+          spec.backend = backend;
+          spec.workers = std::stoi(workers);
           spec.video = video;
           spec.db = args.get("db");
           spec.size = std::stoi(size);
           spec.live = mode == "live";
-          spec.detector_threads = std::stoi(args.get("threads"));
+          spec.detector_threads = std::stoi(threads);
           spec.lag = std::stoi(args.get("lag"));
           spec.out_dir = args.get("out") + "/" + std::filesystem::path(video).stem().string() +
-                         "_" + size + "_" + mode;
+                         "_" + size + "_" + backend + "_w" + workers + "_t" + threads + "_" + mode;
           const Result r = run(spec);
           std::cout << std::fixed << std::setprecision(1) << "| "
                     << std::filesystem::path(video).filename().string() << " | " << size << " | "
-                    << mode << " | " << r.frames << " | " << r.outputs << " | " << r.wall_s << " | "
-                    << r.fps << " | " << std::setprecision(2) << r.people_mean << " ("
-                    << r.people_max << ") | " << r.people3d_mean << " | " << r.quality.tracks
-                    << " | " << r.quality.long_tracks << " | " << r.quality.breaks << " | "
+                    << backend << " | " << workers << " | " << threads << " | " << mode << " | "
+                    << r.frames << " | " << r.outputs << " | " << r.wall_s << " | " << r.fps
+                    << " | " << std::setprecision(2) << r.people_mean << " (" << r.people_max
+                    << ") | " << r.people3d_mean << " | " << r.quality.tracks << " | "
+                    << r.quality.long_tracks << " | " << r.quality.breaks << " | "
                     << r.quality.jumps << " | " << std::setprecision(0);
           if (spec.live) {  // offline frames carry their time in the video, not a capture time
             std::cout << r.latency_p50_ms << " | " << r.latency_p95_ms << " | "
