@@ -51,13 +51,15 @@ Backend resolve_backend(Backend requested);
 
 struct RunnerOptions {
   Backend backend = Backend::automatic;
-  // Threads of this network. XNNPACK: its own pool (1: the calling thread only). cv::dnn: the
-  // process-wide cv::setNumThreads (the last runner made decides). 0: the runtime's default
-  // (XNNPACK: 1 thread per core; cv::dnn: OpenCV's default).
+  // Threads of this network. XNNPACK: its own pool; 0 and 1: the calling thread only (its pool
+  // spins while it waits: measured slower than one thread whenever other work shares the cores,
+  // docs/models.md). cv::dnn: the process-wide cv::setNumThreads (the last runner made decides);
+  // 0: OpenCV's default.
   int threads = 0;
   // Feed the network at this node instead of its input placeholder (empty: the placeholder), e.g.
-  // single-pose MoveNet at "StatefulPartitionedCall/stack", after the batch-of-one reshuffles
-  // of its int32 input, to run a batch of crops. The node's own inputs are then not needed.
+  // single-pose MoveNet at "StatefulPartitionedCall/sub", after the batch-of-one reshuffles of
+  // its int32 input, to run a batch of crops (a bypassed node such as "stack" means its input).
+  // The node's own inputs are then not needed.
   std::string input_node;
 };
 

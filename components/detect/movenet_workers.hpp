@@ -21,7 +21,8 @@ namespace mocap::detect {
 
 class MovenetWorkers {
  public:
-  // `workers` copies of the detector; options.threads is per copy (0 with several copies: 1).
+  // `workers` copies of the detector; options.threads is per copy (0 with several copies: 1, as
+  // cv::dnn's default would put one pool per core behind each copy).
   // Throws like MovenetDetector.
   MovenetWorkers(const std::filesystem::path& model_json, MovenetOptions options, int workers);
 

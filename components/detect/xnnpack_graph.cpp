@@ -588,11 +588,14 @@ void Builder::op_identity(const TfjsNode& n) { set(n, value(n.inputs.at(0))); }
 // The input's int32 -> float Cast is dropped (the input is fed as float); constants convert.
 void Builder::op_cast(const TfjsNode& n) {
   Value v = value(n.inputs.at(0));
+  const TfjsAttr* dst = n.find("DstT");
+  const bool to_int = dst && dst->type != 1 && dst->type != 2 && dst->type != 19;
   if (auto* c = std::get_if<Const>(&v)) {
-    const TfjsAttr* dst = n.find("DstT");
-    c->is_int = dst && dst->type != 1 && dst->type != 2 && dst->type != 19;
-    if (c->is_int)
+    c->is_int = to_int;
+    if (to_int)
       for (double& x : c->v) x = std::trunc(x);
+  } else if (to_int) {
+    throw Unsupported("Cast of a computed tensor to an integer type (tensors are float)");
   }
   set(n, std::move(v));
 }

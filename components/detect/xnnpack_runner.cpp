@@ -82,8 +82,8 @@ class XnnpackRunner : public GraphRunner {
       if (n.name == cut_.input && n.op == "Placeholder")
         if (const TfjsAttr* shape = n.find("shape"); shape && !shape->unknown_rank)
           declared_shape_ = shape->shape;
-    if (threads != 1) {
-      pool_.reset(pthreadpool_create(threads > 1 ? static_cast<std::size_t>(threads) : 0));
+    if (threads > 1) {  // else the calling thread alone
+      pool_.reset(pthreadpool_create(static_cast<std::size_t>(threads)));
       if (!pool_) throw std::runtime_error("could not start the XNNPACK thread pool");
     }
   }

@@ -34,8 +34,8 @@ class MovenetNode : public Node {
                  "cores); outputs stay in frame order",
                  {1, 16});
     c.param<int>("threads", 0,
-                 "threads per copy (0: the runtime's default with 1 worker, else 1); cv::dnn's "
-                 "setting is process-wide",
+                 "threads per copy (0: XNNPACK 1, cv::dnn OpenCV's default with 1 worker, else "
+                 "1); cv::dnn's setting is process-wide",
                  {0, 64});
     c.param<bool>("warm_up", true, "run the network on blank 4:3 and 16:9 frames when it opens");
     c.param<std::string>("model", "", "model.json (empty: the cache tools/setup.sh fills)");
