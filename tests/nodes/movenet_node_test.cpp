@@ -1,7 +1,8 @@
 // The detector nodes in a graph (detect.movenet, detect.topdown, detect.tiles): video frames in,
 // COCO-17 people out with the frames' headers, more than MultiPose's 6 per frame where there are
-// more; a missing model or a bad parameter stops the graph with an error naming the node and the
-// fix.
+// more, on both network runtimes; detect.movenet also from several workers (in frame order, none
+// lost); a missing model, a bad parameter or an unknown runtime stops the graph with an error
+// naming the node and the fix.
 
 #include <gtest/gtest.h>
 
@@ -13,6 +14,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
+#include "detect/graph_runner.hpp"
 #include "detect/model_files.hpp"
 #include "graph/registry.hpp"
 #include "sink_test_util.hpp"
@@ -73,12 +75,15 @@ class CapturePeople2D : public Node {
 };
 MOCAP_REGISTER_NODE("unit.capture_people2d", CapturePeople2D)
 
+// `copies` of the reference frame side by side, `frames` times.
 std::string graph_yaml(const std::string& detector_params,
-                       const std::string& type = "detect.movenet", int copies = 1) {
+                       const std::string& type = "detect.movenet", int copies = 1,
+                       int frames = 2) {
   return R"(
 nodes:
   src: { type: unit.image_file, params: { path: )" +
-         kFrame.string() + ", count: 2, copies: " + std::to_string(copies) + R"( } }
+         kFrame.string() + ", count: " + std::to_string(frames) +
+         ", copies: " + std::to_string(copies) + R"( } }
   det: { type: )" +
          type + ", params: { " + detector_params + R"( } }
   out: { type: unit.capture_people2d }
@@ -96,7 +101,7 @@ TEST(MovenetNode, SendsCoco17PeopleInFramePixelsWithTheFrameHeaders) {
   }
   if (!fs::exists(kFrame)) GTEST_SKIP() << "reference frame absent: " << kFrame;
   captured.clear();
-  const RunResult result = testing::run_graph(graph_yaml("input_size: 512, min_person_score: 0.2"));
+  const RunResult result = testing::run_graph(graph_yaml("input_size: 512, min_person_score: 0.2, warm_up: false"));
   ASSERT_TRUE(result.ok) << result.error;
   ASSERT_EQ(captured.size(), 2u);
   for (std::size_t i = 0; i < captured.size(); ++i) {
@@ -112,6 +117,49 @@ TEST(MovenetNode, SendsCoco17PeopleInFramePixelsWithTheFrameHeaders) {
       EXPECT_LT(p.box.height, 150.0f);
     }
   }
+}
+
+// Two copies on alternate frames, each runtime: every frame's people, in frame order, the same
+// as one copy finds.
+TEST(MovenetNode, WorkersKeepFrameOrderAndLoseNothingOnBothRuntimes) {
+  try {
+    detect::movenet_model_json();
+  } catch (const detect::ModelMissing& e) {
+    GTEST_SKIP() << e.what();
+  }
+  if (!fs::exists(kFrame)) GTEST_SKIP() << "reference frame absent: " << kFrame;
+  for (const std::string backend : {"opencv", "xnnpack"}) {
+    if (backend == "xnnpack" && !detect::xnnpack_available()) continue;
+    SCOPED_TRACE(backend);
+    captured.clear();
+    const RunResult result = testing::run_graph(
+        graph_yaml("input_size: 256, min_person_score: 0.05, warm_up: false, workers: 2, "
+                   "backend: " +
+                       backend,
+                   "detect.movenet", 1, 7));
+    ASSERT_TRUE(result.ok) << result.error;
+    ASSERT_EQ(captured.size(), 7u);
+    for (std::size_t i = 0; i < captured.size(); ++i) {
+      EXPECT_EQ(captured[i].header.frame, static_cast<std::int64_t>(i));
+      EXPECT_EQ(captured[i].header.capture_ns, 1000 + static_cast<std::int64_t>(i));
+      ASSERT_EQ(captured[i].people.size(), captured[0].people.size());
+      ASSERT_FALSE(captured[i].people.empty());
+      EXPECT_FLOAT_EQ(captured[i].people[0].box.x, captured[0].people[0].box.x);
+    }
+  }
+}
+
+TEST(MovenetNode, AnUnknownRuntimeStopsTheGraphNamingTheChoices) {
+  try {
+    detect::movenet_model_json();
+  } catch (const detect::ModelMissing& e) {
+    GTEST_SKIP() << e.what();
+  }
+  if (!fs::exists(kFrame)) GTEST_SKIP() << "reference frame absent: " << kFrame;
+  const RunResult result = testing::run_graph(graph_yaml("backend: tflite"));
+  ASSERT_FALSE(result.ok);
+  EXPECT_NE(result.error.find("'det'"), std::string::npos) << result.error;
+  EXPECT_NE(result.error.find("auto, xnnpack or opencv"), std::string::npos) << result.error;
 }
 
 TEST(MovenetNode, AMissingModelStopsTheGraphNamingTheSetupCommand) {

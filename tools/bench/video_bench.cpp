@@ -1,6 +1,7 @@
 // mocap-bench-video: the whole method on real videos, end to end (decode -> detector -> tracker ->
 // scaler -> matcher -> temporal selection -> smoothing -> JSONL, BVH and overlay MP4), per video
-// and detection strategy (mocap reconstruct --detector names; multipose ones per input size), in
+// and detection strategy (mocap reconstruct --detector names; multipose ones per input size) x
+// network runtime x workers (detect.movenet only) x threads, in
 // two runs each:
 //  * offline: every frame, as fast as possible (the graph of `mocap reconstruct VIDEO`):
 //    frames per second, people per frame, tracks longer than 50 frames, id breaks and jumps;
@@ -10,6 +11,7 @@
 // Prints Markdown tables. A probe node in this program records what reaches the outputs.
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -169,13 +171,18 @@ struct RunSpec {
   int size = 256;                      // its input size when it is a multipose one
   bool live = false;
   int detector_threads = 0;
+  std::string backend = "auto";
+  int workers = 1;
   int lag = 8;
 };
 
 std::string detector_node(const RunSpec& s) {
   const cli::DetectorPreset& preset = cli::detector_preset(s.detector);
   std::ostringstream node;
-  node << "{ type: " << preset.type << ", params: { threads: " << s.detector_threads;
+  node << "{ type: " << preset.type << ", params: { threads: " << s.detector_threads
+       << ", backend: " << s.backend;
+  // Copies on consecutive frames: detect.movenet only (the others follow people frame to frame).
+  if (preset.type == "detect.movenet") node << ", workers: " << s.workers;
   for (const auto& [key, value] : preset.params)
     node << ", " << key << ": " << (key == "input_size" ? std::to_string(s.size) : value);
   node << " } }";
@@ -289,6 +296,17 @@ std::vector<std::string> split(const std::string& list) {
   return out;
 }
 
+// Every runtime x workers x threads x mode of the options, in that order.
+std::vector<std::array<std::string, 4>> matrix(const cli::Args& args) {
+  std::vector<std::array<std::string, 4>> out;
+  for (const std::string& backend : split(args.get("backends")))
+    for (const std::string& workers : split(args.get("workers")))
+      for (const std::string& threads : split(args.get("threads")))
+        for (const std::string& mode : split(args.get("modes")))
+          out.push_back({backend, workers, threads, mode});
+  return out;
+}
+
 }  // namespace
 }  // namespace mocap::bench
 
@@ -307,17 +325,21 @@ int main(int argc, char** argv) {
       .option("sizes", "LIST", "MoveNet input sizes of the multipose detectors", "256,384")
       .option("db", "FILE", "pose database", "build/db/cmu31_train.mdb")
       .option("modes", "LIST", "offline, live or both", "offline,live")
-      .option("threads", "N", "detector threads (0: OpenCV's default)", "0")
+      .option("threads", "LIST", "detector threads per worker (0: the runtime's default)", "0")
+      .option("backends", "LIST", "detector runtimes: auto, xnnpack, opencv", "auto")
+      .option("workers", "LIST", "detector workers (copies on consecutive frames; detect.movenet only)", "1")
       .option("lag", "N", "temporal selection look-ahead in frames", "8")
       .option("out", "DIR", "where each run's outputs go", "/tmp/mocap-bench-video");
   int exit_code = 0;
   if (!args.parse(argc - 1, argv + 1, exit_code)) return exit_code;
   try {
     std::cout
-        << "| video | detector | mode | frames | 3D outputs | wall s | fps | people/frame (max) "
+        << "| video | detector | runtime | workers | threads | mode | frames | 3D outputs | "
+           "wall s | fps | people/frame (max) "
            "| 3D people/frame | tracks | tracks > 50 | id breaks | id jumps | latency p50 "
            "ms | p95 ms | p50 first / last quarter ms | src skips | det drops | det p50 ms |\n"
-        << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+        << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+           "---|\n";
     for (const std::string& video : split(args.get("videos"))) {
       if (!std::filesystem::exists(video)) {
         std::cout << "| " << video << " | absent, skipped |\n";
@@ -334,24 +356,27 @@ int main(int argc, char** argv) {
       }
       for (const auto& [detector, size] : variants) {
         const std::string label = size.empty() ? detector : detector + "@" + size;
-        for (const std::string& mode : split(args.get("modes"))) {
+        for (const auto& [backend, workers, threads, mode] : matrix(args)) {
           RunSpec spec;
+          spec.backend = backend;
+          spec.workers = std::stoi(workers);
           spec.video = video;
           spec.db = args.get("db");
           spec.detector = detector;
           if (!size.empty()) spec.size = std::stoi(size);
           spec.live = mode == "live";
-          spec.detector_threads = std::stoi(args.get("threads"));
+          spec.detector_threads = std::stoi(threads);
           spec.lag = std::stoi(args.get("lag"));
           spec.out_dir = args.get("out") + "/" + std::filesystem::path(video).stem().string() +
-                         "_" + label + "_" + mode;
+                         "_" + label + "_" + backend + "_w" + workers + "_t" + threads + "_" + mode;
           const Result r = run(spec);
           std::cout << std::fixed << std::setprecision(1) << "| "
                     << std::filesystem::path(video).filename().string() << " | " << label << " | "
-                    << mode << " | " << r.frames << " | " << r.outputs << " | " << r.wall_s << " | "
-                    << r.fps << " | " << std::setprecision(2) << r.people_mean << " ("
-                    << r.people_max << ") | " << r.people3d_mean << " | " << r.quality.tracks
-                    << " | " << r.quality.long_tracks << " | " << r.quality.breaks << " | "
+                    << backend << " | " << workers << " | " << threads << " | " << mode << " | "
+                    << r.frames << " | " << r.outputs << " | " << r.wall_s << " | " << r.fps
+                    << " | " << std::setprecision(2) << r.people_mean << " (" << r.people_max
+                    << ") | " << r.people3d_mean << " | " << r.quality.tracks << " | "
+                    << r.quality.long_tracks << " | " << r.quality.breaks << " | "
                     << r.quality.jumps << " | " << std::setprecision(0);
           if (spec.live) {  // offline frames carry their time in the video, not a capture time
             std::cout << r.latency_p50_ms << " | " << r.latency_p95_ms << " | "
