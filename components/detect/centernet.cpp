@@ -9,7 +9,7 @@ namespace mocap::detect {
 namespace {
 
 // σ(class logits) and the box sides ×16: the graph's tower_0/keypoints and tower_0/wh, whose
-// Identity nodes cv::dnn drops, so the nodes before them.
+// Identity nodes cv::dnn drops, so the nodes before them (the same for both runtimes).
 const std::array<std::string, 2> kHeads = {"tower_0/Sigmoid", "tower_0/mul"};
 constexpr int kStride = 4;
 
@@ -24,30 +24,36 @@ float iou(const Box2D& a, const Box2D& b) {
   return uni > 0 ? inter / uni : 0.0f;
 }
 
-std::vector<Detection> decode_centernet(const Tensor& heatmap, const Tensor& sides, int class_id,
-                                        float min_score, int max_count) {
-  const int h = heatmap.height, w = heatmap.width;
-  if (heatmap.batch < 1 || sides.batch < 1 || sides.channels != 4 || sides.height != h ||
-      sides.width != w || class_id < 0 || class_id >= heatmap.channels ||
-      heatmap.values.size() < heatmap.plane() * heatmap.channels ||
-      sides.values.size() < sides.plane() * 4)
+std::vector<Detection> decode_centernet(const GraphTensor& heatmap, const GraphTensor& sides,
+                                        int class_id, float min_score, int max_count) {
+  if (heatmap.shape.size() != 4 || sides.shape.size() != 4)
     throw std::invalid_argument("CenterNet heads of inconsistent shapes");
-  const float* heat = heatmap.at(0, class_id);
+  const int h = static_cast<int>(heatmap.shape[1]), w = static_cast<int>(heatmap.shape[2]);
+  const int classes = static_cast<int>(heatmap.shape[3]);
+  if (heatmap.shape[0] < 1 || sides.shape[0] < 1 || sides.shape[1] != h || sides.shape[2] != w ||
+      sides.shape[3] != 4 || h <= 0 || w <= 0 || class_id < 0 || class_id >= classes ||
+      heatmap.values.size() != heatmap.size() || sides.values.size() != sides.size())
+    throw std::invalid_argument("CenterNet heads of inconsistent shapes");
+  // Image 0, NHWC: class c of cell i at i · classes + c, side s at i · 4 + s.
+  const auto heat_at = [&](std::size_t i) {
+    return heatmap
+        .values[i * static_cast<std::size_t>(classes) + static_cast<std::size_t>(class_id)];
+  };
   std::vector<Detection> found;
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
-      const float v = heat[y * w + x];
+      const float v = heat_at(static_cast<std::size_t>(y) * w + x);
       if (v < min_score) continue;
       // A peak equals the 3 × 3 maximum around it (SAME padding: the border has fewer cells).
       bool peak = true;
       for (int yy = std::max(0, y - 1); peak && yy <= std::min(h - 1, y + 1); ++yy)
         for (int xx = std::max(0, x - 1); xx <= std::min(w - 1, x + 1); ++xx)
-          if (heat[yy * w + xx] > v) peak = false;
+          if (heat_at(static_cast<std::size_t>(yy) * w + xx) > v) peak = false;
       if (!peak) continue;
       const std::size_t i = static_cast<std::size_t>(y) * w + x;
       const float cx = static_cast<float>(kStride * x), cy = static_cast<float>(kStride * y);
-      const float left = sides.at(0, 0)[i], top = sides.at(0, 1)[i];
-      const float right = sides.at(0, 2)[i], bottom = sides.at(0, 3)[i];
+      const float* side = sides.values.data() + i * 4;
+      const float left = side[0], top = side[1], right = side[2], bottom = side[3];
       found.push_back({{cx - left, cy - top, left + right, top + bottom}, v});
     }
   }
@@ -71,21 +77,21 @@ std::vector<Detection> suppress_overlaps(std::vector<Detection> detections, floa
   return kept;
 }
 
-CenternetNetwork::CenternetNetwork(const std::filesystem::path& model_json)
-    : graph_(model_json, kHeads) {}
+CenternetNetwork::CenternetNetwork(const std::filesystem::path& model_json,
+                                   const RunnerOptions& options)
+    : runner_(make_graph_runner(model_json, kHeads, options)) {}
 
-std::vector<Tensor> CenternetNetwork::run(const Tensor& image) {
-  if (image.batch != 1 || image.channels != 3 || image.height != kCenternetInput ||
-      image.width != kCenternetInput)
-    throw std::invalid_argument("CenterNet takes one 3 x 512 x 512 image");
-  std::vector<Tensor> heads = graph_.run(image);
+const std::vector<GraphTensor>& CenternetNetwork::run(const GraphTensor& image) {
+  if (image.shape != std::vector<std::int64_t>{1, kCenternetInput, kCenternetInput, 3} ||
+      image.values.size() != image.size())
+    throw std::invalid_argument("CenterNet takes one 512 x 512 x 3 image");
+  runner_->run({image.shape, image.values}, heads_);
   const int grid = kCenternetInput / kStride;
-  if (heads.size() != 2 || heads[0].height != grid || heads[0].width != grid ||
-      heads[1].channels != 4)
+  if (heads_.size() != 2 || heads_[0].shape.size() != 4 || heads_[1].shape.size() != 4 ||
+      heads_[0].shape[1] != grid || heads_[0].shape[2] != grid || heads_[1].shape[3] != 4)
     throw std::runtime_error(
-        "CenterNet: heads of an unexpected shape (is the model file the "
-        "right one?)");
-  return heads;
+        "CenterNet: heads of an unexpected shape (is the model file the right one?)");
+  return heads_;
 }
 
 }  // namespace mocap::detect

@@ -2,6 +2,7 @@
 
 #include <stdexcept>
 
+#include "detect/model_files.hpp"
 #include "detect/runner_backends.hpp"
 
 namespace mocap::detect {
@@ -72,8 +73,14 @@ std::unique_ptr<GraphRunner> make_graph_runner(std::shared_ptr<const TfjsModel> 
 std::unique_ptr<GraphRunner> make_graph_runner(const std::filesystem::path& model_json,
                                                std::span<const std::string> outputs,
                                                const RunnerOptions& options) {
-  return make_graph_runner(std::make_shared<const TfjsModel>(read_tfjs_model(model_json)), outputs,
-                           options);
+  try {
+    return make_graph_runner(std::make_shared<const TfjsModel>(read_tfjs_model(model_json)),
+                             outputs, options);
+  } catch (const ModelError& e) {
+    // A damaged file, or another model's (no such outputs): the user's fix is fetching it again.
+    throw ModelError(std::string(e.what()) + "; if the file is damaged or not this model, " +
+                     kFetchModelsHint);
+  }
 }
 
 }  // namespace mocap::detect

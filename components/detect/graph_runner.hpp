@@ -78,7 +78,8 @@ class GraphRunner {
 
 // Loads `model_json` for the named outputs ("node" or "node:1"). Throws std::runtime_error naming
 // the model file: unreadable or inconsistent files, outputs the graph lacks, every operation the
-// chosen runtime does not support (by op and node name), or `xnnpack` asked in a build without it.
+// chosen runtime does not support (by op and node name; ModelError, which also names the command
+// that fetches the models), or `xnnpack` asked in a build without it.
 std::unique_ptr<GraphRunner> make_graph_runner(const std::filesystem::path& model_json,
                                                std::span<const std::string> outputs,
                                                const RunnerOptions& options);

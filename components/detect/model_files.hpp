@@ -17,8 +17,8 @@ class ModelMissing : public std::runtime_error {
 std::filesystem::path model_cache_dir();
 
 // <cache>/<name>/<name>.json of a model tools/setup.sh fetches (movenet-multipose,
-// movenet-lightning, movenet-thunder, centernet), its weights beside it. Throws ModelMissing
-// naming the folder and the command that fetches it.
+// movenet-lightning, movenet-thunder, centernet, nanodet), its weights beside it. Throws
+// ModelMissing naming the folder and the command that fetches it.
 std::filesystem::path cached_model_json(std::string_view name);
 
 // model.json of MoveNet MultiPose in the cache, its weights beside it. Throws ModelMissing.

@@ -4,8 +4,6 @@
 #include <cmath>
 #include <stdexcept>
 
-#include <opencv2/core.hpp>
-
 #include "detect/person_boxes.hpp"
 
 namespace mocap::detect {
@@ -19,6 +17,13 @@ void check(const TileOptions& o) {
   if (o.tile_input_size < 32 || o.tile_input_size % 32 || o.frame_input_size < 0 ||
       o.frame_input_size % 32)
     throw std::invalid_argument("tiles: input sizes must be multiples of 32");
+}
+
+RunnerOptions runner_options(const TileOptions& o) {
+  RunnerOptions r;
+  r.backend = o.backend;
+  r.threads = o.threads;
+  return r;
 }
 
 // The image inside `rect`, sharing the frame's pixels.
@@ -68,16 +73,14 @@ std::vector<PixelRect> tile_grid(int width, int height, int columns, int rows, f
 }
 
 TiledDetector::TiledDetector(const std::filesystem::path& model_json, const TileOptions& options)
-    : options_((check(options), options)), network_(model_json) {
-  if (options_.threads > 0) cv::setNumThreads(options_.threads);
-}
+    : options_((check(options), options)), network_(model_json, runner_options(options)) {}
 
 std::vector<MovenetPerson> TiledDetector::detect(const ImageBuffer& frame) {
   std::vector<MovenetPerson> found, cut;
   const auto run = [&](const ImageBuffer& image, int input_size) {
     const MovenetInput input = prepare_movenet_input(image, input_size);
-    return select_people(decode_movenet(network_.run(input.tensor)), input.mapping,
-                         options_.thresholds);
+    network_.run(input.tensor, heads_);
+    return select_people(decode_movenet(heads_), input.mapping, options_.thresholds);
   };
   if (options_.frame_input_size > 0) found = run(frame, options_.frame_input_size);
   for (const PixelRect& rect : tile_grid(frame.width(), frame.height(), options_.columns,

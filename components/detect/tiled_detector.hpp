@@ -21,7 +21,9 @@ struct TileOptions {
   int frame_input_size = 256;  // the whole-frame pass (0: none)
   MovenetThresholds thresholds;
   float duplicate_overlap = 0.5f;  // people whose boxes overlap more are one
-  int threads = 0;                 // cv::dnn threads (0: OpenCV's default)
+  // The network runtime and its threads, as MovenetOptions (graph_runner.hpp).
+  Backend backend = Backend::automatic;
+  int threads = 0;
 };
 
 // The tiles of a frame: columns × rows rectangles in frame pixels, overlapping by `overlap` of
@@ -38,10 +40,12 @@ class TiledDetector {
 
   std::vector<MovenetPerson> detect(const ImageBuffer& frame);
   const TileOptions& options() const { return options_; }
+  Backend backend() const { return network_.backend(); }
 
  private:
   TileOptions options_;
   MovenetNetwork network_;
+  MovenetHeads heads_;  // reused from pass to pass
 };
 
 }  // namespace mocap::detect

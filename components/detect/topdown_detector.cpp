@@ -5,8 +5,6 @@
 #include <stdexcept>
 #include <string>
 
-#include <opencv2/core.hpp>
-
 #include "detect/image_tensor.hpp"
 #include "detect/person_boxes.hpp"
 
@@ -24,6 +22,13 @@ void check(const TopDownOptions& o) {
     throw std::invalid_argument("min_keypoints must lie in [1, 17]");
 }
 
+RunnerOptions runner_options(const TopDownOptions& o) {
+  RunnerOptions r;
+  r.backend = o.backend;
+  r.threads = o.threads;
+  return r;
+}
+
 Box2D moved(const Box2D& box, float dx, float dy) {
   return {box.x + dx, box.y + dy, box.width, box.height};
 }
@@ -34,10 +39,8 @@ TopDownDetector::TopDownDetector(const TopDownOptions& options,
                                  const std::filesystem::path& pose_model_json,
                                  const std::filesystem::path& centernet_json)
     : options_((check(options), options)),
-      pose_(options.pose_model, pose_model_json),
-      boxes_(std::make_unique<CenternetNetwork>(centernet_json)) {
-  if (options_.threads > 0) cv::setNumThreads(options_.threads);
-}
+      pose_(options.pose_model, pose_model_json, runner_options(options)),
+      boxes_(std::make_unique<CenternetNetwork>(centernet_json, runner_options(options))) {}
 
 TopDownDetector::~TopDownDetector() = default;
 
@@ -48,9 +51,9 @@ void TopDownDetector::reset() {
 }
 
 std::vector<Detection> TopDownDetector::find_boxes(const ImageBuffer& frame) {
-  Tensor image = image_batch(1, kCenternetInput, kCenternetInput);
-  fill_stretched(frame, image, 0);
-  const std::vector<Tensor> heads = boxes_->run(image);
+  image_batch(image_, 1, kCenternetInput, kCenternetInput);
+  fill_stretched(frame, image_, 0);
+  const std::vector<GraphTensor>& heads = boxes_->run(image_);
   std::vector<Detection> found =
       decode_centernet(heads[0], heads[1], kCenternetPersonClass, options_.min_box_score, -1);
   const float sx = static_cast<float>(frame.width()) / kCenternetInput;
@@ -66,13 +69,13 @@ std::vector<MovenetPerson> TopDownDetector::pose(const ImageBuffer& frame,
   std::vector<MovenetPerson> people;
   if (boxes.empty()) return people;
   const int size = pose_.input_size();
-  Tensor crops = image_batch(static_cast<int>(boxes.size()), size, size);
+  image_batch(crops_, static_cast<int>(boxes.size()), size, size);
   std::vector<SquareRegion> regions;
   for (std::size_t i = 0; i < boxes.size(); ++i) {
     regions.push_back(square_around(boxes[i], options_.crop_padding));
-    fill_region(frame, regions.back(), crops, static_cast<int>(i));
+    fill_region(frame, regions.back(), crops_, static_cast<int>(i));
   }
-  const std::vector<SinglePoseKeypoints> found = pose_.run(crops);
+  const std::vector<SinglePoseKeypoints> found = pose_.run(crops_);
   for (std::size_t i = 0; i < found.size(); ++i) {
     const SquareRegion& r = regions[i];
     MovenetPerson person;

@@ -34,7 +34,9 @@ struct TopDownOptions {
   int min_keypoints = 6;
   float min_person_score = 0.35f;
   float duplicate_overlap = 0.6f;  // people whose boxes overlap more are one
-  // cv::dnn threads, 0 for OpenCV's default. OpenCV's setting is process-wide.
+  // The network runtime of both networks and their threads (graph_runner.hpp: XNNPACK's are each
+  // network's own, 0 meaning one; cv::dnn's are process-wide, 0 its default).
+  Backend backend = Backend::automatic;
   int threads = 0;
 };
 
@@ -51,6 +53,8 @@ class TopDownDetector {
   void reset();
 
   const TopDownOptions& options() const { return options_; }
+  // The runtime the networks run on (`automatic` resolved).
+  Backend backend() const { return pose_.backend(); }
   // Frames on which the person detector ran, of all frames seen.
   long long detector_runs() const { return detector_runs_; }
 
@@ -65,6 +69,7 @@ class TopDownDetector {
   TopDownOptions options_;
   SinglePoseNetwork pose_;
   std::unique_ptr<CenternetNetwork> boxes_;
+  GraphTensor image_, crops_;  // the networks' inputs, reused from frame to frame
   std::vector<Followed> followed_;
   long long frame_ = 0, detector_runs_ = 0;
   bool lost_someone_ = false;

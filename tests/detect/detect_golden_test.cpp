@@ -1,7 +1,8 @@
-// The C++ ports of MoveNet single-pose (Lightning, Thunder) and MB3-CenterNet (TF.js model ->
-// cv::dnn, post-processing in C++) against the outputs TensorFlow.js computed from the same models
-// and pixels (tests/data/detection/tfjs_reference.json, made by
-// tools/reference/make_detect_reference.sh; see tests/data/detection/README.md).
+// The C++ ports of MoveNet single-pose (Lightning, Thunder) and MB3-CenterNet (TF.js model run by
+// each network runtime, cv::dnn and XNNPACK; post-processing in C++) against the outputs
+// TensorFlow.js computed from the same models and pixels, the graph's own post-processing included
+// (tests/data/detection/tfjs_reference.json, made by tools/reference/make_detect_reference.sh; see
+// tests/data/detection/README.md).
 
 #include <gtest/gtest.h>
 
@@ -11,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <iostream>
 #include <memory>
 
 #include <nlohmann/json.hpp>
@@ -31,14 +33,15 @@ const fs::path kFrame =
     fs::path("..") / "shared" / "docs" / "models" / "movenet-multipose" / "vtest-f300.png";
 const fs::path kReference = fs::path("tests") / "data" / "detection" / "tfjs_reference.json";
 
-// Heads: cv::dnn and TF.js agree to a few 1e-4 (float32 sums in another order); decoded keypoints
-// (normalised to the crop) and CenterNet boxes (input pixels) as closely as the heads allow.
+// Heads: both runtimes and TF.js agree to a few 1e-4 (float32 sums in another order); decoded
+// keypoints (normalised to the crop) and CenterNet boxes (input pixels) as closely as the heads
+// allow.
 constexpr double kHeadTolerance = 1e-3;
 constexpr double kKeypointTolerance = 2e-4;
 constexpr double kScoreTolerance = 2e-4;
 constexpr double kBoxTolerance = 0.02;  // pixels of the 512 × 512 input
 
-class DetectGolden : public ::testing::Test {
+class DetectGolden : public ::testing::TestWithParam<Backend> {
  protected:
   static void SetUpTestSuite() {
     for (const char* name : {"movenet-lightning", "movenet-thunder", "centernet"}) {
@@ -60,18 +63,26 @@ class DetectGolden : public ::testing::Test {
 
   void SetUp() override {
     if (!skip_.empty()) GTEST_SKIP() << skip_;
+    if (GetParam() == Backend::xnnpack && !xnnpack_available())
+      GTEST_SKIP() << "this build has no XNNPACK runtime";
   }
 
-  // The case's window of the frame as one image of `batch`.
-  static void fill(const json& c, Tensor& batch, int n) {
+  RunnerOptions runtime() const {
+    RunnerOptions options;
+    options.backend = GetParam();
+    options.threads = 1;
+    return options;
+  }
+
+  // The case's window of the frame as image n of `batch` (NHWC, RGB 0..255).
+  static void fill(const json& c, GraphTensor& batch, int n) {
     const auto w = c.at("window_x_y_size");
     const int size = w[2];
     const cv::Mat window = frame_rgb_(cv::Rect(w[0], w[1], size, size));
+    float* out = batch.values.data() + static_cast<std::size_t>(n) * size * size * 3;
     for (int y = 0; y < size; ++y)
-      for (int x = 0; x < size; ++x)
-        for (int ch = 0; ch < 3; ++ch)
-          batch.values[((static_cast<std::size_t>(n) * 3 + ch) * size + y) * size + x] =
-              window.at<cv::Vec3b>(y, x)[ch];
+      for (int x = 0; x < size; ++x, out += 3)
+        for (int ch = 0; ch < 3; ++ch) out[ch] = window.at<cv::Vec3b>(y, x)[ch];
   }
 
   static std::vector<json> cases(const std::string& model) {
@@ -86,33 +97,40 @@ class DetectGolden : public ::testing::Test {
   static inline cv::Mat frame_rgb_;
 };
 
-// Largest difference between the heads at the reference's cells (NCHW here, NHWC there).
-double head_difference(const std::vector<Tensor>& heads, const json& ref, int n) {
+// Largest difference between the heads of image n at the reference's cells (NHWC both).
+double head_difference(const std::vector<GraphTensor>& heads, const json& ref, int n) {
   double worst = 0;
   for (std::size_t h = 0; h < heads.size(); ++h) {
     const json& r = ref.at(h);
-    const Tensor& t = heads[h];
-    EXPECT_EQ(t.channels, r.at("shape_nhwc")[3].get<int>());
+    const GraphTensor& t = heads[h];
+    EXPECT_EQ(t.shape.at(3), r.at("shape_nhwc")[3].get<std::int64_t>());
+    const auto width = static_cast<std::size_t>(t.shape[2]);
+    const auto channels = static_cast<std::size_t>(t.shape[3]);
+    const std::size_t image = static_cast<std::size_t>(n) * t.shape[1] * width * channels;
     for (std::size_t i = 0; i < r.at("cells_yx").size(); ++i) {
-      const int y = r.at("cells_yx")[i][0], x = r.at("cells_yx")[i][1];
-      for (int ch = 0; ch < t.channels; ++ch) {
+      const std::size_t y = r.at("cells_yx")[i][0], x = r.at("cells_yx")[i][1];
+      for (std::size_t ch = 0; ch < channels; ++ch) {
         const double want = r.at("values_at_cells")[i][ch];
-        worst = std::max(worst, std::fabs(t.at(n, ch)[y * t.width + x] - want));
+        worst =
+            std::max(worst, std::fabs(t.values[image + (y * width + x) * channels + ch] - want));
       }
     }
   }
   return worst;
 }
 
-void check_singlepose(SinglePoseModel model, const std::vector<json>& refs,
-                      const std::function<void(const json&, Tensor&, int)>& fill) {
-  SinglePoseNetwork network(model, cached_model_json(model_name(model)));
+void check_singlepose(SinglePoseModel model, const RunnerOptions& runtime,
+                      const std::vector<json>& refs,
+                      const std::function<void(const json&, GraphTensor&, int)>& fill) {
+  SinglePoseNetwork network(model, cached_model_json(model_name(model)), runtime);
+  EXPECT_EQ(network.backend(), runtime.backend);
   const int size = network.input_size();
   // All the model's cases in one batch: the batch must not change a crop's result.
-  Tensor batch{static_cast<int>(refs.size()), 3, size, size, {}};
-  batch.values.assign(static_cast<std::size_t>(batch.batch) * 3 * size * size, 0.0f);
+  GraphTensor batch;
+  batch.shape = {static_cast<std::int64_t>(refs.size()), size, size, 3};
+  batch.values.assign(batch.size(), 0.0f);
   for (std::size_t n = 0; n < refs.size(); ++n) fill(refs[n], batch, static_cast<int>(n));
-  const std::vector<Tensor> heads = network.run_heads(batch);
+  const std::vector<GraphTensor> heads = network.run_heads(batch);
   for (std::size_t n = 0; n < refs.size(); ++n) {
     SCOPED_TRACE(refs[n].at("id").get<std::string>());
     EXPECT_LT(head_difference(heads, refs[n].at("heads"), static_cast<int>(n)), kHeadTolerance);
@@ -132,22 +150,24 @@ void check_singlepose(SinglePoseModel model, const std::vector<json>& refs,
   }
 }
 
-TEST_F(DetectGolden, LightningMatchesTfjsInOneBatch) {
-  check_singlepose(SinglePoseModel::lightning, cases("movenet-lightning"), fill);
+TEST_P(DetectGolden, LightningMatchesTfjsInOneBatch) {
+  check_singlepose(SinglePoseModel::lightning, runtime(), cases("movenet-lightning"), fill);
 }
 
-TEST_F(DetectGolden, ThunderMatchesTfjsInOneBatch) {
-  check_singlepose(SinglePoseModel::thunder, cases("movenet-thunder"), fill);
+TEST_P(DetectGolden, ThunderMatchesTfjsInOneBatch) {
+  check_singlepose(SinglePoseModel::thunder, runtime(), cases("movenet-thunder"), fill);
 }
 
-TEST_F(DetectGolden, CenternetPersonBoxesMatchTfjs) {
-  CenternetNetwork network(cached_model_json("centernet"));
+TEST_P(DetectGolden, CenternetPersonBoxesMatchTfjs) {
+  CenternetNetwork network(cached_model_json("centernet"), runtime());
+  EXPECT_EQ(network.backend(), GetParam());
   for (const json& c : cases("centernet")) {
     SCOPED_TRACE(c.at("id").get<std::string>());
-    Tensor image{1, 3, kCenternetInput, kCenternetInput, {}};
-    image.values.assign(3 * kCenternetInput * kCenternetInput, 0.0f);
+    GraphTensor image;
+    image.shape = {1, kCenternetInput, kCenternetInput, 3};
+    image.values.assign(image.size(), 0.0f);
     fill(c, image, 0);
-    const std::vector<Tensor> heads = network.run(image);
+    const std::vector<GraphTensor>& heads = network.run(image);
     EXPECT_LT(head_difference(heads, c.at("heads"), 0), kHeadTolerance);
     const json& want = c.at("person_rows_x0_y0_x1_y1_score_class");
     const auto got = decode_centernet(heads[0], heads[1], kCenternetPersonClass, 0.05f, -1);
@@ -170,6 +190,10 @@ TEST_F(DetectGolden, CenternetPersonBoxesMatchTfjs) {
   }
 }
 
+INSTANTIATE_TEST_SUITE_P(Runtimes, DetectGolden,
+                         ::testing::Values(Backend::opencv, Backend::xnnpack),
+                         [](const auto& p) { return std::string(backend_name(p.param)); });
+
 TEST(DetectModels, AWrongModelFileIsRefusedNamingItAndTheFetchCommand) {
   std::string centernet;
   try {
@@ -177,13 +201,19 @@ TEST(DetectModels, AWrongModelFileIsRefusedNamingItAndTheFetchCommand) {
   } catch (const ModelMissing& e) {
     GTEST_SKIP() << e.what();
   }
-  try {
-    SinglePoseNetwork network(SinglePoseModel::lightning, centernet);
-    FAIL() << "a CenterNet file loaded as MoveNet Lightning";
-  } catch (const std::runtime_error& e) {
-    const std::string what = e.what();
-    EXPECT_NE(what.find(centernet), std::string::npos) << what;
-    EXPECT_NE(what.find("tools/setup.sh --models-only"), std::string::npos) << what;
+  for (const Backend backend : {Backend::automatic, Backend::opencv, Backend::xnnpack}) {
+    if (backend == Backend::xnnpack && !xnnpack_available()) continue;
+    SCOPED_TRACE(backend_name(backend));
+    RunnerOptions options;
+    options.backend = backend;
+    try {
+      SinglePoseNetwork network(SinglePoseModel::lightning, centernet, options);
+      FAIL() << "a CenterNet file loaded as MoveNet Lightning";
+    } catch (const std::runtime_error& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find(centernet), std::string::npos) << what;
+      EXPECT_NE(what.find("tools/setup.sh --models-only"), std::string::npos) << what;
+    }
   }
 }
 
