@@ -77,8 +77,7 @@ MOCAP_REGISTER_NODE("unit.capture_people2d", CapturePeople2D)
 
 // `copies` of the reference frame side by side, `frames` times.
 std::string graph_yaml(const std::string& detector_params,
-                       const std::string& type = "detect.movenet", int copies = 1,
-                       int frames = 2) {
+                       const std::string& type = "detect.movenet", int copies = 1, int frames = 2) {
   return R"(
 nodes:
   src: { type: unit.image_file, params: { path: )" +
@@ -101,7 +100,8 @@ TEST(MovenetNode, SendsCoco17PeopleInFramePixelsWithTheFrameHeaders) {
   }
   if (!fs::exists(kFrame)) GTEST_SKIP() << "reference frame absent: " << kFrame;
   captured.clear();
-  const RunResult result = testing::run_graph(graph_yaml("input_size: 512, min_person_score: 0.2, warm_up: false"));
+  const RunResult result =
+      testing::run_graph(graph_yaml("input_size: 512, min_person_score: 0.2, warm_up: false"));
   ASSERT_TRUE(result.ok) << result.error;
   ASSERT_EQ(captured.size(), 2u);
   for (std::size_t i = 0; i < captured.size(); ++i) {
@@ -192,40 +192,54 @@ bool models_present() {
   }
 }
 
+// The runtimes this build has.
+std::vector<std::string> runtimes() {
+  if (detect::xnnpack_available()) return {"opencv", "xnnpack"};
+  return {"opencv"};
+}
+
 // Two copies of the frame side by side: twelve pedestrians, more than MultiPose's 6 per image.
-TEST(TopDownNode, FindsMoreThanSixPeopleInFramePixels) {
+TEST(TopDownNode, FindsMoreThanSixPeopleInFramePixelsOnBothRuntimes) {
   if (!models_present()) GTEST_SKIP() << "models or reference frame absent";
-  captured.clear();
-  const RunResult result =
-      testing::run_graph(graph_yaml("detect_every: 1", "detect.topdown", /*copies=*/2));
-  ASSERT_TRUE(result.ok) << result.error;
-  ASSERT_EQ(captured.size(), 2u);
-  for (std::size_t i = 0; i < captured.size(); ++i) {
-    const People2D& people = captured[i];
-    EXPECT_EQ(people.header.frame, static_cast<std::int64_t>(i));
-    EXPECT_EQ(people.layout, LayoutId::coco17);
-    EXPECT_GT(people.people.size(), 6u);
-    int left = 0, right = 0;
-    for (const Person2D& p : people.people) {
-      ASSERT_EQ(p.joints.size(), 17u);
-      EXPECT_GT(p.box.height, 40.0f);
-      EXPECT_LT(p.box.height, 150.0f);
-      (p.box.x + p.box.width / 2 < 768 ? left : right) += 1;
+  for (const std::string& backend : runtimes()) {
+    SCOPED_TRACE(backend);
+    captured.clear();
+    const RunResult result = testing::run_graph(
+        graph_yaml("detect_every: 1, backend: " + backend, "detect.topdown", /*copies=*/2));
+    ASSERT_TRUE(result.ok) << result.error;
+    ASSERT_EQ(captured.size(), 2u);
+    for (std::size_t i = 0; i < captured.size(); ++i) {
+      const People2D& people = captured[i];
+      EXPECT_EQ(people.header.frame, static_cast<std::int64_t>(i));
+      EXPECT_EQ(people.layout, LayoutId::coco17);
+      EXPECT_GT(people.people.size(), 6u);
+      int left = 0, right = 0;
+      for (const Person2D& p : people.people) {
+        ASSERT_EQ(p.joints.size(), 17u);
+        EXPECT_GT(p.box.height, 40.0f);
+        EXPECT_LT(p.box.height, 150.0f);
+        (p.box.x + p.box.width / 2 < 768 ? left : right) += 1;
+      }
+      EXPECT_GE(left, 4);  // the pedestrians of both copies
+      EXPECT_GE(right, 4);
     }
-    EXPECT_GE(left, 4);  // the pedestrians of both copies
-    EXPECT_GE(right, 4);
   }
 }
 
-TEST(TilesNode, FindsMoreThanSixPeople) {
+TEST(TilesNode, FindsMoreThanSixPeopleOnBothRuntimes) {
   if (!models_present()) GTEST_SKIP() << "models or reference frame absent";
-  captured.clear();
-  const RunResult result = testing::run_graph(graph_yaml(
-      "columns: 2, rows: 1, tile_input_size: 512, frame_input_size: 0, min_person_score: 0.2",
-      "detect.tiles", /*copies=*/2));
-  ASSERT_TRUE(result.ok) << result.error;
-  ASSERT_EQ(captured.size(), 2u);
-  EXPECT_GT(captured[0].people.size(), 6u);
+  for (const std::string& backend : runtimes()) {
+    SCOPED_TRACE(backend);
+    captured.clear();
+    const RunResult result = testing::run_graph(graph_yaml(
+        "columns: 2, rows: 1, tile_input_size: 512, frame_input_size: 0, min_person_score: 0.2, "
+        "backend: " +
+            backend,
+        "detect.tiles", /*copies=*/2));
+    ASSERT_TRUE(result.ok) << result.error;
+    ASSERT_EQ(captured.size(), 2u);
+    EXPECT_GT(captured[0].people.size(), 6u);
+  }
 }
 
 TEST(TopDownNode, BadParametersAndMissingModelsNameTheNodeAndTheFix) {
@@ -240,6 +254,9 @@ TEST(TopDownNode, BadParametersAndMissingModelsNameTheNodeAndTheFix) {
   result = testing::run_graph(graph_yaml("model: /nonexistent/m.json", "detect.tiles"));
   ASSERT_FALSE(result.ok);
   EXPECT_NE(result.error.find("tools/setup.sh --models-only"), std::string::npos) << result.error;
+  result = testing::run_graph(graph_yaml("backend: tflite", "detect.topdown"));
+  ASSERT_FALSE(result.ok);
+  EXPECT_NE(result.error.find("auto, xnnpack or opencv"), std::string::npos) << result.error;
 }
 
 }  // namespace

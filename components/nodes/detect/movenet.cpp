@@ -11,6 +11,7 @@
 #include "detect/model_files.hpp"
 #include "detect/movenet_workers.hpp"
 #include "graph/registry.hpp"
+#include "people_message.hpp"
 
 namespace mocap::nodes {
 using namespace mocap::graph;
@@ -75,16 +76,9 @@ class MovenetNode : public Node {
  private:
   // The oldest frame's people, with that frame's header.
   void send(Context& ctx, const std::vector<detect::MovenetPerson>& found) {
-    People2D out;
+    People2D out = to_people2d(found);
     out.header = headers_.front();
     headers_.pop_front();
-    out.layout = LayoutId::coco17;
-    for (const detect::MovenetPerson& p : found) {
-      Person2D person;
-      person.box = p.box;
-      person.joints.assign(p.keypoints.begin(), p.keypoints.end());
-      out.people.push_back(std::move(person));
-    }
     ctx.send("out", std::move(out));
   }
 

@@ -2,6 +2,7 @@
 // frame, for small and distant people and for more than 6 people (components/detect
 // TiledDetector). The model comes from the cache tools/setup.sh fills.
 
+#include <iostream>
 #include <optional>
 
 #include "detect/model_files.hpp"
@@ -17,7 +18,7 @@ class TilesNode : public Node {
   static void contract(Contract& c) {
     c.doc(
         "Finds small and distant people: MoveNet MultiPose on overlapping tiles and on the "
-        "whole frame, duplicates merged (cv::dnn)");
+        "whole frame, duplicates merged (cv::dnn or XNNPACK)");
     c.input<VideoFrame>("in", "video frames, any pixel format");
     c.output<People2D>("out", "COCO-17 people in frame pixels, best first, id -1 (untracked)");
     c.param<int>("columns", 2, "tiles across", {1, 8});
@@ -31,7 +32,13 @@ class TilesNode : public Node {
                  {0, 1024});
     c.param<double>("min_person_score", 0.25, "people scoring below are dropped", {0.0, 1.0});
     c.param<double>("min_keypoint_score", 0.3, "keypoints scoring below are missing", {0.0, 1.0});
-    c.param<int>("threads", 0, "cv::dnn threads, process-wide (0: OpenCV's default)", {0, 64});
+    c.param<std::string>("backend", "auto",
+                         "network runtime: auto (XNNPACK when built in, else cv::dnn), xnnpack, "
+                         "opencv");
+    c.param<int>("threads", 0,
+                 "network threads (0: XNNPACK 1, cv::dnn OpenCV's default); cv::dnn's setting is "
+                 "process-wide",
+                 {0, 64});
     c.param<std::string>("model", "", "model.json (empty: the cache tools/setup.sh fills)");
   }
 
@@ -44,6 +51,7 @@ class TilesNode : public Node {
     o.frame_input_size = ctx.param<int>("frame_input_size");
     o.thresholds.min_person_score = ctx.param<float>("min_person_score");
     o.thresholds.min_keypoint_score = ctx.param<float>("min_keypoint_score");
+    o.backend = detect::parse_backend(ctx.param<std::string>("backend"));
     o.threads = ctx.param<int>("threads");
     const std::string given = ctx.param<std::string>("model");
     if (!given.empty() && !std::filesystem::is_regular_file(given))
@@ -51,6 +59,8 @@ class TilesNode : public Node {
                                  ", or leave `model` empty");
     detector_.emplace(given.empty() ? detect::movenet_model_json() : std::filesystem::path(given),
                       o);
+    std::cerr << "node '" << ctx.node_name() << "': tiles on "
+              << detect::backend_name(detector_->backend()) << "\n";
   }
 
   void process(Context& ctx) override {

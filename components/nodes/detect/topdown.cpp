@@ -3,6 +3,7 @@
 // TopDownDetector). No cap on the number of people. Models come from the cache tools/setup.sh
 // fills; a missing or wrong one stops the graph naming it and that command.
 
+#include <iostream>
 #include <optional>
 
 #include "detect/model_files.hpp"
@@ -18,7 +19,7 @@ class TopDownNode : public Node {
   static void contract(Contract& c) {
     c.doc(
         "Finds every person: CenterNet boxes at a low rate, MoveNet single-pose keypoints per "
-        "person on crops that follow them (cv::dnn)");
+        "person on crops that follow them (cv::dnn or XNNPACK)");
     c.input<VideoFrame>("in", "video frames in order, any pixel format");
     c.output<People2D>("out", "COCO-17 people in frame pixels, best first, id -1 (untracked)");
     c.param<std::string>("pose_model", "lightning",
@@ -36,7 +37,13 @@ class TopDownNode : public Node {
     c.param<double>("min_keypoint_score", 0.3, "keypoints scoring below are missing", {0.0, 1.0});
     c.param<double>("crop_padding", 1.25, "crop side = the person's longer box side x this",
                     {1.0, 4.0});
-    c.param<int>("threads", 0, "cv::dnn threads, process-wide (0: OpenCV's default)", {0, 64});
+    c.param<std::string>("backend", "auto",
+                         "network runtime: auto (XNNPACK when built in, else cv::dnn), xnnpack, "
+                         "opencv");
+    c.param<int>("threads", 0,
+                 "network threads (0: XNNPACK 1, cv::dnn OpenCV's default); cv::dnn's setting is "
+                 "process-wide",
+                 {0, 64});
     c.param<std::string>("pose_model_file", "", "model.json (empty: the cache)");
     c.param<std::string>("box_model_file", "", "CenterNet model.json (empty: the cache)");
   }
@@ -54,11 +61,14 @@ class TopDownNode : public Node {
     o.min_keypoints = ctx.param<int>("min_keypoints");
     o.min_keypoint_score = ctx.param<float>("min_keypoint_score");
     o.crop_padding = ctx.param<float>("crop_padding");
+    o.backend = detect::parse_backend(ctx.param<std::string>("backend"));
     o.threads = ctx.param<int>("threads");
     detector_.emplace(
         o,
         file_or_cache(ctx.param<std::string>("pose_model_file"), detect::model_name(o.pose_model)),
         file_or_cache(ctx.param<std::string>("box_model_file"), "centernet"));
+    std::cerr << "node '" << ctx.node_name() << "': top-down on "
+              << detect::backend_name(detector_->backend()) << "\n";
   }
 
   void process(Context& ctx) override {
