@@ -2,7 +2,9 @@
 // and strategy: recall and precision against the hand-checked boxes of tests/data/detection/,
 // median keypoint distance to the reference strategy (the first listed), people per frame over
 // every frame, and frames/s end to end (decoding + detection, offline, every frame in order, so
-// that strategies that follow people between detector runs work as they would on the file).
+// that strategies that follow people between detector runs work as they would on the file). Each
+// strategy runs on each network runtime asked for (--backends: cv::dnn, XNNPACK). The networks'
+// forward time alone is mocap-bench-networks'.
 // Prints a Markdown table per input; --json writes every number.
 //
 // Also the tool that made the boxes: --candidates DIR writes the reference strategy's boxes on
@@ -57,12 +59,13 @@ std::vector<std::string> split(const std::string& text, char sep) {
   return out;
 }
 
-// multipose:SIZE | tiles:CxR:TILE:FRAME | topdown:lightning|thunder:EVERY
-Strategy make_strategy(const std::string& spec, int threads) {
+// multipose:SIZE | tiles:CxR:TILE:FRAME | topdown:lightning|thunder:EVERY, on `backend`.
+Strategy make_strategy(const std::string& spec, detect::Backend backend, int threads) {
   const auto parts = split(spec, ':');
   if (parts.size() == 2 && parts[0] == "multipose") {
     detect::MovenetOptions o;
     o.input_size = std::stoi(parts[1]);
+    o.backend = backend;
     o.threads = threads;
     auto d = std::make_shared<detect::MovenetDetector>(detect::movenet_model_json(), o);
     return {spec, [d](const ImageBuffer& f) { return d->detect(f); }};
@@ -75,6 +78,7 @@ Strategy make_strategy(const std::string& spec, int threads) {
     o.rows = std::stoi(grid[1]);
     o.tile_input_size = std::stoi(parts[2]);
     o.frame_input_size = std::stoi(parts[3]);
+    o.backend = backend;
     o.threads = threads;
     auto d = std::make_shared<detect::TiledDetector>(detect::movenet_model_json(), o);
     return {spec, [d](const ImageBuffer& f) { return d->detect(f); }};
@@ -86,6 +90,7 @@ Strategy make_strategy(const std::string& spec, int threads) {
     o.pose_model = parts[1] == "thunder" ? detect::SinglePoseModel::thunder
                                          : detect::SinglePoseModel::lightning;
     o.detect_every = std::stoi(parts[2]);
+    o.backend = backend;
     o.threads = threads;
     auto d = std::make_shared<detect::TopDownDetector>(
         o, detect::cached_model_json(detect::model_name(o.pose_model)),
@@ -269,13 +274,16 @@ int main(int argc, char** argv) {
               "../shared/data/eval/openpose_examples_media/COCO_val2014_000000000328.jpg,"
               "../shared/data/eval/openpose_examples_media/COCO_val2014_000000000536.jpg")
       .option("strategies", "LIST",
-              "the first is the reference for keypoint distances: multipose:SIZE, "
+              "the first (on the first runtime) is the reference for keypoint distances: "
+              "multipose:SIZE, "
               "tiles:CxR:TILE:FRAME, topdown:lightning|thunder:EVERY",
               "topdown:thunder:1,multipose:256,multipose:512,tiles:2x2:256:256,"
               "topdown:lightning:1,topdown:lightning:10,topdown:thunder:10")
       .option("truth", "DIR", "hand-checked boxes", "tests/data/detection")
       .option("iou", "X", "a detection matches a true box at this IoU", "0.5")
-      .option("threads", "N", "cv::dnn threads (0: OpenCV's default)", "0")
+      .option("backends", "LIST",
+              "network runtimes, each strategy runs on each: auto, xnnpack, opencv", "auto")
+      .option("threads", "N", "network threads (0: XNNPACK 1, cv::dnn OpenCV's default)", "0")
       .option("json", "FILE", "write every number here")
       .flag("only-annotated",
             "detect on the annotated frames only (each one alone: no following between frames; "
@@ -310,11 +318,14 @@ int main(int argc, char** argv) {
       std::vector<Run> runs;
       std::vector<std::string> names;
       for (const std::string& spec : split(args.get("strategies"), ',')) {
-        Strategy s = make_strategy(spec, threads);
-        runs.push_back(run(s, input, only));
-        names.push_back(spec);
-        std::fprintf(stderr, "%s %s: %d frames, %.1f s\n", stem.c_str(), spec.c_str(),
-                     runs.back().frames, runs.back().seconds);
+        for (const std::string& runtime : split(args.get("backends"), ',')) {
+          const detect::Backend backend = detect::resolve_backend(detect::parse_backend(runtime));
+          Strategy s = make_strategy(spec, backend, threads);
+          runs.push_back(run(s, input, only));
+          names.push_back(spec + "@" + std::string(detect::backend_name(backend)));
+          std::fprintf(stderr, "%s %s: %d frames, %.1f s\n", stem.c_str(), names.back().c_str(),
+                       runs.back().frames, runs.back().seconds);
+        }
       }
       if (args.has("candidates")) {
         fs::create_directories(args.get("candidates"));

@@ -1,6 +1,6 @@
 // mocap-bench-movenet: MoveNet MultiPose latency by input size and thread count on one real
 // frame: network forward (cv::dnn or XNNPACK), decoding, and the input preparation, as medians and
-// minima over timed runs after warm-up. Prints a Markdown table. (mocap-bench-detect compares the
+// minima over timed runs after warm-up. Prints a Markdown table. (mocap-bench-networks compares the
 // runtimes on every network.)
 
 #include <algorithm>

@@ -327,7 +327,8 @@ int main(int argc, char** argv) {
       .option("modes", "LIST", "offline, live or both", "offline,live")
       .option("threads", "LIST", "detector threads per worker (0: the runtime's default)", "0")
       .option("backends", "LIST", "detector runtimes: auto, xnnpack, opencv", "auto")
-      .option("workers", "LIST", "detector workers (copies on consecutive frames; detect.movenet only)", "1")
+      .option("workers", "LIST",
+              "detector workers (copies on consecutive frames; detect.movenet only)", "1")
       .option("lag", "N", "temporal selection look-ahead in frames", "8")
       .option("out", "DIR", "where each run's outputs go", "/tmp/mocap-bench-video");
   int exit_code = 0;

@@ -121,8 +121,10 @@ void configure_video(graph::GraphSpec& spec, const Args& args, const VideoInfo& 
                        "add --detector multipose");
     set_param(spec, "detect.movenet", "input_size", args.get("detector-size"));
   }
-  for (const auto& preset : detector_presets())
+  for (const auto& preset : detector_presets()) {
     set_param(spec, preset.type, "threads", args.get("detector-threads"));
+    set_param(spec, preset.type, "backend", args.get("detector-backend"));
+  }
   const double fps = args.has("fps") ? std::stod(args.get("fps")) : info.fps > 0 ? info.fps : 30.0;
   for (const char* type : {"sink.bvh", "sink.overlay"}) set_param(spec, type, "fps", number(fps));
   const std::string width = std::to_string(info.width), height = std::to_string(info.height);
@@ -313,7 +315,12 @@ int reconstruct_command(int argc, char** argv) {
       .option("detector-size", "N",
               "video, multipose detectors: MoveNet input size, a multiple of 32 (256 fast, "
               "384-512 for small people)")
-      .option("detector-threads", "N", "video: detector threads (0: OpenCV's default)", "0")
+      .option("detector-backend", "NAME",
+              "video: network runtime of the detector: auto (XNNPACK when built in, else "
+              "cv::dnn), xnnpack or opencv (docs/models.md)",
+              "auto")
+      .option("detector-threads", "N",
+              "video: detector network threads (0: XNNPACK 1, cv::dnn OpenCV's default)", "0")
       .option("decoder-threads", "N",
               "video: FFmpeg decoding threads (0: one per core; needs OpenCV >= 4.7)", "0")
       .option("image-size", "WxH",
