@@ -1,5 +1,6 @@
 #include "detect/singlepose.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -138,12 +139,25 @@ const std::vector<GraphTensor>& SinglePoseNetwork::run_heads(const GraphTensor& 
 }
 
 std::vector<SinglePoseKeypoints> SinglePoseNetwork::run(const GraphTensor& crops) {
-  const std::vector<GraphTensor>& heads = run_heads(crops);
+  constexpr int kLargestPass = 8;
+  if (crops.shape.size() != 4 || crops.values.size() != crops.size())
+    throw std::invalid_argument(std::string(model_name(model_)) + ": malformed crop batch");
   const int batch = static_cast<int>(crops.shape[0]);
+  const std::size_t per_crop = batch > 0 ? crops.size() / static_cast<std::size_t>(batch) : 0;
   std::vector<SinglePoseKeypoints> out;
-  out.reserve(static_cast<std::size_t>(batch));
-  for (int n = 0; n < batch; ++n)
-    out.push_back(decode_singlepose(heads[0], heads[1], heads[2], heads[3], n));
+  out.reserve(static_cast<std::size_t>(std::max(batch, 0)));
+  for (int done = 0; done < batch;) {
+    int pass = kLargestPass;
+    while (pass > batch - done) pass /= 2;
+    pass_.shape = crops.shape;
+    pass_.shape[0] = pass;
+    const auto first = crops.values.begin() + static_cast<std::ptrdiff_t>(done * per_crop);
+    pass_.values.assign(first, first + static_cast<std::ptrdiff_t>(pass * per_crop));
+    const std::vector<GraphTensor>& heads = run_heads(pass_);
+    for (int n = 0; n < pass; ++n)
+      out.push_back(decode_singlepose(heads[0], heads[1], heads[2], heads[3], n));
+    done += pass;
+  }
   return out;
 }
 

@@ -55,13 +55,16 @@ class SinglePoseNetwork {
   // The heads for a batch of crops: NHWC [N, size, size, 3] float RGB 0..255, size =
   // input_size(). In the order center, heatmap, regress, offset; valid until the next call.
   const std::vector<GraphTensor>& run_heads(const GraphTensor& crops);
-  // The keypoints of every crop of the batch.
+  // The keypoints of every crop of the batch, run in passes of 8, 4, 2 and 1 crops: the XNNPACK
+  // runtime builds itself per input shape (about 0.3 s) and keeps the last 4, so whatever the
+  // number of people, these four shapes are all it ever builds.
   std::vector<SinglePoseKeypoints> run(const GraphTensor& crops);
 
  private:
   SinglePoseModel model_;
   std::unique_ptr<GraphRunner> runner_;
   std::vector<GraphTensor> heads_;  // reused from call to call
+  GraphTensor pass_;                // the crops of one pass
 };
 
 }  // namespace mocap::detect

@@ -158,6 +158,30 @@ TEST_P(DetectGolden, ThunderMatchesTfjsInOneBatch) {
   check_singlepose(SinglePoseModel::thunder, runtime(), cases("movenet-thunder"), fill);
 }
 
+// run() goes through the crops in passes of 8, 4, 2, 1 (3 crops: 2 + 1); each crop's keypoints
+// are those of one pass over the whole batch.
+TEST_P(DetectGolden, LightningRunInPassesEqualsOneBatch) {
+  const auto refs = cases("movenet-lightning");
+  ASSERT_EQ(refs.size(), 2u);
+  SinglePoseNetwork network(SinglePoseModel::lightning,
+                            cached_model_json(model_name(SinglePoseModel::lightning)), runtime());
+  GraphTensor batch;
+  batch.shape = {3, 192, 192, 3};
+  batch.values.assign(batch.size(), 0.0f);
+  fill(refs[0], batch, 0);
+  fill(refs[1], batch, 1);
+  fill(refs[0], batch, 2);
+  const std::vector<SinglePoseKeypoints> passes = network.run(batch);
+  ASSERT_EQ(passes.size(), 3u);
+  const std::vector<GraphTensor> heads = network.run_heads(batch);
+  for (int n = 0; n < 3; ++n) {
+    const SinglePoseKeypoints whole = decode_singlepose(heads[0], heads[1], heads[2], heads[3], n);
+    for (int k = 0; k < kMovenetKeypoints; ++k)
+      for (int i = 0; i < 3; ++i)
+        EXPECT_NEAR(passes[static_cast<std::size_t>(n)][k][i], whole[k][i], 1e-5) << n << " " << k;
+  }
+}
+
 TEST_P(DetectGolden, CenternetPersonBoxesMatchTfjs) {
   CenternetNetwork network(cached_model_json("centernet"), runtime());
   EXPECT_EQ(network.backend(), GetParam());
