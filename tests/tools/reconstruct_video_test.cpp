@@ -59,7 +59,8 @@ bool model_present() {
 TEST_F(ReconstructVideoTest, AVideoBecomesPosesBvhAndAnOverlayVideo) {
   if (!model_present()) GTEST_SKIP() << "MoveNet model absent: tools/setup.sh --models-only";
   auto run =
-      reconstruct("out", kVideo.string(), {"--detector-size", "384", "--set", "src.count=30"});
+      reconstruct("out", kVideo.string(),
+                  {"--detector", "multipose", "--detector-size", "384", "--set", "src.count=30"});
   ASSERT_EQ(run.wait(300s), 0) << run.err();
   const std::string out = dir_->file("out");
   const auto lines = test::read_lines(out + "/poses.jsonl");
@@ -103,7 +104,8 @@ TEST_F(ReconstructVideoTest, AVideoBecomesPosesBvhAndAnOverlayVideo) {
   const auto summary = nlohmann::json::parse(test::read_file(out + "/summary.json"));
   EXPECT_EQ(summary.at("video").at("width"), 768);
   EXPECT_EQ(summary.at("video").at("height"), 576);
-  EXPECT_EQ(summary.at("detector_size"), 384);
+  EXPECT_EQ(summary.at("detector").at("type"), "detect.movenet");
+  EXPECT_EQ(summary.at("detector").at("params").at("input_size"), "384");
   EXPECT_EQ(summary.at("frames"), 30);
   EXPECT_EQ(summary.at("fit"), "full");
   EXPECT_NE(run.out().find(out + "/overlay.mp4"), std::string::npos) << run.out();

@@ -32,6 +32,7 @@
 #include "core/keypoint_layout.hpp"
 #include "core/messages.hpp"
 #include "detect/model_files.hpp"
+#include "detector_presets.hpp"
 #include "eval_report.hpp"
 #include "graph/graph_spec.hpp"
 #include "graph/plugins.hpp"
@@ -139,8 +140,19 @@ void configure_video(graph::GraphSpec& spec, const Args& args, const VideoInfo& 
   set_param(spec, "source.video", "path", args.positionals()[0]);
   set_param(spec, "source.video", "decoder_threads", args.get("decoder-threads"));
   if (args.has("fps")) set_param(spec, "source.video", "fps", args.get("fps"));
-  set_param(spec, "detect.movenet", "input_size", args.get("detector-size"));
-  set_param(spec, "detect.movenet", "threads", args.get("detector-threads"));
+  if (args.has("detector-size")) {
+    const bool multipose = std::any_of(spec.nodes.begin(), spec.nodes.end(),
+                                       [](const auto& n) { return n.type == "detect.movenet"; });
+    if (!multipose)
+      throw InputError("--detector-size",
+                       "sets the input size of the multipose detectors only; "
+                       "add --detector multipose");
+    set_param(spec, "detect.movenet", "input_size", args.get("detector-size"));
+  }
+  for (const auto& preset : detector_presets()) {
+    set_param(spec, preset.type, "threads", args.get("detector-threads"));
+    set_param(spec, preset.type, "backend", args.get("detector-backend"));
+  }
   const double fps = info.fps > 0 ? info.fps : args.has("fps") ? args.number("fps") : 30.0;
   for (const char* type : {"sink.bvh", "sink.overlay"}) set_param(spec, type, "fps", number(fps));
   const std::string width = std::to_string(info.width), height = std::to_string(info.height);
@@ -154,13 +166,45 @@ void configure_video(graph::GraphSpec& spec, const Args& args, const VideoInfo& 
   if (!info.live) read_frames_in_overlay(spec, args.positionals()[0]);
 }
 
-// A graph with a MoveNet node on the cached model: a missing model is reported before anything
+bool is_detector(const std::string& type) {
+  for (const auto& preset : detector_presets())
+    if (preset.type == type) return true;
+  return false;
+}
+
+// Puts the named strategy in place of the graph's detector node (same name, same edges).
+void choose_detector(graph::GraphSpec& spec, const std::string& name) {
+  const DetectorPreset& preset = detector_preset(name);
+  bool found = false;
+  for (auto& node : spec.nodes) {
+    if (!is_detector(node.type)) continue;
+    node.type = preset.type;
+    node.params.clear();
+    for (const auto& [key, value] : preset.params)
+      node.params[key] = {value, {"mocap reconstruct --detector", 0}};
+    found = true;
+  }
+  if (!found) throw InputError("--detector", "the graph has no detector node to replace");
+}
+
+// A graph with detector nodes on the cached models: a missing model is reported before anything
 // runs, naming the command that fetches it.
 void check_detector_model(const graph::GraphSpec& spec) {
+  const auto given = [](const graph::NodeSpec& node, const char* key) {
+    const auto it = node.params.find(key);
+    return it != node.params.end() && !it->second.text.empty();
+  };
   for (const auto& node : spec.nodes) {
-    if (node.type != "detect.movenet") continue;
-    const auto model = node.params.find("model");
-    if (model == node.params.end() || model->second.text.empty()) detect::movenet_model_json();
+    if (node.type == "detect.movenet" || node.type == "detect.tiles") {
+      if (!given(node, "model")) detect::movenet_model_json();
+    } else if (node.type == "detect.topdown") {
+      if (!given(node, "box_model_file")) detect::cached_model_json("centernet");
+      if (!given(node, "pose_model_file")) {
+        const auto it = node.params.find("pose_model");
+        const bool thunder = it != node.params.end() && it->second.text == "thunder";
+        detect::cached_model_json(thunder ? "movenet-thunder" : "movenet-lightning");
+      }
+    }
   }
 }
 
@@ -413,10 +457,22 @@ int reconstruct_command(int argc, char** argv) {
               "of a camera; every output uses it. A video file or stream has its own rate: "
               "another --fps is refused",
               std::nullopt, Range::between(0.1, 1000.0))
+      .option("detector", "NAME",
+              "video: how people are found: auto (" + std::string(kFileDetector) + " for files, " +
+                  std::string(kLiveDetector) +
+                  " for cameras and streams; docs/detection-strategies.md) or one of " +
+                  detector_names(),
+              "auto")
       .option("detector-size", "N",
-              "video: MoveNet input size, a multiple of 32 (256 fast, 384-512 for small people)",
-              "256", Range::count(128, 1024))
-      .option("detector-threads", "N", "video: detector threads (0: OpenCV's default)", "0",
+              "video, multipose detectors: MoveNet input size, a multiple of 32 (256 fast, "
+              "384-512 for small people)",
+              std::nullopt, Range::count(128, 1024))
+      .option("detector-backend", "NAME",
+              "video: network runtime of the detector: auto (XNNPACK when built in, else "
+              "cv::dnn), xnnpack or opencv (docs/models.md)",
+              "auto")
+      .option("detector-threads", "N",
+              "video: detector network threads (0: XNNPACK 1, cv::dnn OpenCV's default)", "0",
               Range::count(0, 64))
       .option("decoder-threads", "N",
               "video: FFmpeg decoding threads (0: one per core; needs OpenCV >= 4.7)", "0",
@@ -457,7 +513,7 @@ int reconstruct_command(int argc, char** argv) {
   int code = 0;
   if (!args.parse(argc, argv, code)) return code;
   if (!args.has("out")) throw InputError("--out", "required: the output folder");
-  if (args.integer("detector-size") % 32 != 0)
+  if (args.has("detector-size") && args.integer("detector-size") % 32 != 0)
     throw InputError("--detector-size",
                      "expected a multiple of 32, got " + args.get("detector-size"));
   const std::string input = args.positionals()[0];
@@ -485,6 +541,14 @@ int reconstruct_command(int argc, char** argv) {
              (kind == InputKind::video ? "monocular_video.yaml" : "monocular_json.yaml"))
                 .string();
   graph::GraphSpec spec = graph::load_graph_file(graph_file);
+  if (kind == InputKind::video) {
+    // The default graph carries the file default; --graph keeps its own unless asked.
+    const std::string detector = args.get("detector");
+    if (detector != "auto")
+      choose_detector(spec, detector);
+    else if (info.live && !args.has("graph"))
+      choose_detector(spec, std::string(kLiveDetector));
+  }
   configure(spec, args, out, kind);
   if (kind == InputKind::video) configure_video(spec, args, info);
   const std::string fit = fit_mode(args, kind, info.live);
@@ -492,6 +556,12 @@ int reconstruct_command(int argc, char** argv) {
   set_param(spec, "recon.fit", "ground", args.get("ground"));
   graph::apply_overrides(spec, args.all("set"));
   check_detector_model(spec);
+  json detector_summary = json::object();
+  for (const auto& node : spec.nodes) {
+    if (!is_detector(node.type)) continue;
+    detector_summary["type"] = node.type;
+    for (const auto& [key, value] : node.params) detector_summary["params"][key] = value.text;
+  }
   const graph::ResolvedGraph resolved = graph::resolve(std::move(spec));
   refuse_outputs_over_inputs(args, out, graph_file);
   graph::RunOptions options;
@@ -549,7 +619,8 @@ int reconstruct_command(int argc, char** argv) {
   summary["fit"] = fit;
   summary["graph"] = graph_file;
   if (kind == InputKind::video) {
-    summary["detector_size"] = args.integer("detector-size");
+    summary["detector"] = detector_summary;
+    if (args.has("detector-size")) summary["detector_size"] = args.integer("detector-size");
     summary["video"] = {
         {"width", info.width}, {"height", info.height}, {"fps", info.fps}, {"frames", info.frames}};
   }
