@@ -9,25 +9,20 @@
 // detection, so that a recording can be replayed beside its input (mocap view), `ground` once the
 // floor is known (points p with normal . p + offset = 0, normal up).
 //
-// The file is created when the first frame arrives (a run that fails before leaves an earlier
-// file untouched). Each line is one write, flushed, so the file holds every finished frame even
-// if the run is killed; a kill in the middle of a write can only leave the last line cut, without
-// its newline (readers skip such a tail: web::read_poses_jsonl, mocap reconstruct's summary).
-
-#include <fcntl.h>
-#include <unistd.h>
+// The file is written through io::LineFile: created when the first frame arrives (a run that
+// fails before leaves an earlier file untouched), one write per line, so the file holds every
+// finished frame even if the run is killed; a kill in the middle of a write can only leave the
+// last line cut, without its newline (readers skip such a tail: web::read_poses_jsonl, mocap
+// reconstruct's summary).
 
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
-#include <cstring>
-#include <filesystem>
-#include <string_view>
+#include <optional>
 
 #include <nlohmann/json.hpp>
 
-#include "core/input_error.hpp"
 #include "graph/registry.hpp"
+#include "io/line_file.hpp"
 
 namespace mocap::nodes {
 using namespace mocap::graph;
@@ -45,15 +40,10 @@ class JsonLinesSink : public Node {
   // port, a bad parameter of another node) leaves an earlier file of that name untouched; that
   // it can be written is checked now, without touching it, so such a run still fails at once.
   void open(Context& ctx) override {
-    path_ = ctx.param<std::string>("path");
-    check_writable(path_);
+    file_.emplace(ctx.param<std::string>("path"));
+    file_->check_writable();
   }
   void process(Context& ctx) override {
-    if (!file_) {
-      file_.reset(::open(path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644));
-      if (!file_)
-        throw InputError(path_, std::string("cannot create the file: ") + std::strerror(errno));
-    }
     const auto& in = ctx.input<People3D>("in");
     nlohmann::ordered_json people = nlohmann::ordered_json::array();
     for (const Person3D& p : in.people) {
@@ -69,8 +59,7 @@ class JsonLinesSink : public Node {
       line["ground"] = {{"normal", {in.ground.normal.x, in.ground.normal.y, in.ground.normal.z}},
                         {"offset", round_mm(in.ground.offset)}};
     }
-    const std::string text = line.dump() + "\n";
-    write_line(text);
+    file_->write(line.dump());
   }
   void close(Context&) override { file_.reset(); }
 
@@ -100,66 +89,7 @@ class JsonLinesSink : public Node {
   }
   // Millimetre precision keeps the file small and the numbers readable.
   static double round_mm(float v) { return std::round(static_cast<double>(v) * 1000.0) / 1000.0; }
-  // An existing file is opened for writing and closed (not truncated); for a new one its folder
-  // is made and a file created and removed beside it (access() says yes to root even in /proc).
-  static void check_writable(const std::string& path) {
-    namespace fs = std::filesystem;
-    std::error_code ec;
-    if (fs::exists(path, ec)) {
-      const int fd = ::open(path.c_str(), O_WRONLY | O_NONBLOCK | O_CLOEXEC);
-      if (fd < 0)
-        throw InputError(path, std::string("cannot write the file: ") + std::strerror(errno));
-      ::close(fd);
-      return;
-    }
-    const fs::path folder = fs::path(path).parent_path();
-    if (!folder.empty() && !fs::create_directories(folder, ec) && ec)
-      throw InputError(path, "cannot create the file: " + ec.message());
-    // Built by append: GCC 12 warns (falsely, -Wrestrict) on "." + name + ".probe".
-    std::string probe_name = ".";
-    probe_name.append(fs::path(path).filename().string()).append(".probe");
-    const fs::path probe = (folder.empty() ? fs::path(".") : folder) / probe_name;
-    const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
-    if (fd < 0 && errno != EEXIST)
-      throw InputError(path, std::string("cannot create the file: ") + std::strerror(errno));
-    if (fd >= 0) {
-      ::close(fd);
-      ::unlink(probe.c_str());
-    }
-  }
-  // One write() per line (retried only if the kernel writes part of it); on a failure the file
-  // is cut back to its last whole line, so it stays valid.
-  void write_line(std::string_view text) {
-    std::string_view rest = text;
-    while (!rest.empty()) {
-      const ssize_t n = ::write(file_.get(), rest.data(), rest.size());
-      if (n < 0 && errno == EINTR) continue;
-      if (n <= 0) {
-        const int error = n == 0 ? EIO : errno;
-        [[maybe_unused]] const int cut = ::ftruncate(file_.get(), end_);  // best effort
-        throw InputError(path_, std::string("write failed: ") + std::strerror(error) +
-                                    " (disk full or over the file size limit?)");
-      }
-      rest.remove_prefix(static_cast<std::size_t>(n));
-    }
-    end_ += static_cast<off_t>(text.size());
-  }
-  struct Fd {
-    int fd = -1;
-    Fd() = default;
-    Fd(const Fd&) = delete;
-    Fd& operator=(const Fd&) = delete;
-    ~Fd() { reset(); }
-    void reset(int to = -1) {
-      if (fd >= 0) ::close(fd);
-      fd = to;
-    }
-    int get() const { return fd; }
-    explicit operator bool() const { return fd >= 0; }
-  };
-  std::string path_;
-  Fd file_;
-  off_t end_ = 0;  // size after the last whole line
+  std::optional<io::LineFile> file_;
 };
 
 MOCAP_REGISTER_NODE("sink.jsonl", JsonLinesSink)
