@@ -1,5 +1,6 @@
 #include "viz/overlay_output.hpp"
 
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -19,8 +20,19 @@ struct OverlayOutput::Impl {
   std::optional<video::Mp4Writer> video;  // created with the first picture
   int width = 0, height = 0;
   std::int64_t pictures = 0;
+  std::chrono::steady_clock::time_point last_write{};
+  double rate = 0.0;  // pictures per second, smoothed
   std::int64_t pngs = 0;
 
+  // An exponential average of the intervals between pictures: how fast the whole graph runs.
+  void measure_rate() {
+    const auto now = std::chrono::steady_clock::now();
+    if (last_write != std::chrono::steady_clock::time_point{}) {
+      const double seconds = std::chrono::duration<double>(now - last_write).count();
+      if (seconds > 0.0) rate = rate > 0.0 ? 0.9 * rate + 0.1 / seconds : 1.0 / seconds;
+    }
+    last_write = now;
+  }
   void write_png(const cv::Mat& bgr, std::int64_t frame) {
     char name[64];
     std::snprintf(name, sizeof name, "overlay_%06lld.png", static_cast<long long>(frame));
@@ -76,6 +88,7 @@ void OverlayOutput::write(const ImageBuffer& picture, std::int64_t frame) {
   if (o.options.png_every > 0 && o.pictures % o.options.png_every == 0)
     o.write_png(to_bgr(picture), frame);
   ++o.pictures;
+  o.measure_rate();
 }
 
 void OverlayOutput::close() {
@@ -84,5 +97,6 @@ void OverlayOutput::close() {
 
 std::int64_t OverlayOutput::pictures() const { return impl_->pictures; }
 std::int64_t OverlayOutput::pngs() const { return impl_->pngs; }
+double OverlayOutput::pictures_per_second() const { return impl_->rate; }
 
 }  // namespace mocap::viz

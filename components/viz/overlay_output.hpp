@@ -36,6 +36,8 @@ class OverlayOutput {
 
   std::int64_t pictures() const;  // written so far
   std::int64_t pngs() const;
+  // Pictures written per second of wall-clock time, smoothed (0 before the second one).
+  double pictures_per_second() const;
 
  private:
   struct Impl;

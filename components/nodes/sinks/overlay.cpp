@@ -6,7 +6,6 @@
 // (video::FrameReader) instead of coming on the `video` port, so no decoded frame waits here for
 // its 3D (the offline fit sends it a window later).
 
-#include <chrono>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -87,7 +86,7 @@ class OverlaySink : public Node {
       if (auto frame = frames_->frame(people3d.header.frame)) background = std::move(frame->image);
     }
     output_->write(renderer_->render(ctx.input<People2D>("people2d"), people3d, background,
-                                     {people3d.header.frame, rate()}),
+                                     {people3d.header.frame, output_->pictures_per_second()}),
                    people3d.header.frame);
   }
 
@@ -104,23 +103,10 @@ class OverlaySink : public Node {
   }
 
  private:
-  // Frames drawn per second of wall-clock time, smoothed: how fast the whole graph runs.
-  double rate() {
-    const auto now = std::chrono::steady_clock::now();
-    if (last_ != std::chrono::steady_clock::time_point{}) {
-      const double seconds = std::chrono::duration<double>(now - last_).count();
-      if (seconds > 0.0) fps_ = fps_ > 0.0 ? 0.9 * fps_ + 0.1 / seconds : 1.0 / seconds;
-    }
-    last_ = now;
-    return fps_;
-  }
-
   std::unique_ptr<viz::OverlayOutput> output_;
   std::unique_ptr<viz::OverlayRenderer> renderer_;
   std::optional<video::FrameReader> frames_;  // with video_path
   std::int64_t undrawn_ = 0;
-  std::chrono::steady_clock::time_point last_{};
-  double fps_ = 0.0;
 };
 
 MOCAP_REGISTER_NODE("sink.overlay", OverlaySink)
