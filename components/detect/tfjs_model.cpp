@@ -134,10 +134,10 @@ TfjsWeight read_weight(const json& spec, std::string_view data, std::size_t& off
   if (dtype == "int32" && stored == "int32") {
     w.is_int = true;
     w.ints.resize(n);
-    std::memcpy(w.ints.data(), src, bytes);
+    if (bytes > 0) std::memcpy(w.ints.data(), src, bytes);  // an empty tensor has no buffer
   } else if (dtype == "float32" && stored == "float32") {
     w.floats.resize(n);
-    std::memcpy(w.floats.data(), src, bytes);
+    if (bytes > 0) std::memcpy(w.floats.data(), src, bytes);
   } else if (dtype == "float32" && stored == "float16") {
     w.floats.resize(n);
     for (std::size_t i = 0; i < n; ++i) {

@@ -1,5 +1,6 @@
 #include "multiview/observations.hpp"
 
+#include <functional>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -49,8 +50,20 @@ void FrameObservations::add_person(int view, std::span<const float> xyc) {
                                 std::to_string(keypoints_ * 3) + " values, got " +
                                 std::to_string(xyc.size()));
   }
+  // `xyc` may be a person already in this view (a detection added twice): growing the view moves
+  // it, so it is found again by its place.
+  std::size_t from = 0;
+  bool inside = false;
+  if (view >= 0 && view < views()) {  // else add_person(view) says what is wrong
+    const std::vector<float>& stored = views_[static_cast<std::size_t>(view)];
+    const std::less<const float*> before;
+    inside = !stored.empty() && !before(xyc.data(), stored.data()) &&
+             before(xyc.data(), stored.data() + stored.size());
+    if (inside) from = static_cast<std::size_t>(xyc.data() - stored.data());
+  }
   const std::span<float> out = add_person(view);
-  std::copy(xyc.begin(), xyc.end(), out.begin());
+  const float* source = inside ? views_[static_cast<std::size_t>(view)].data() + from : xyc.data();
+  std::copy(source, source + xyc.size(), out.begin());
 }
 
 int FrameObservations::people(int view) const {
