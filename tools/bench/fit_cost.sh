@@ -73,6 +73,6 @@ for fit in off full; do
   echo "Per node, last run with --fit $fit:"
   echo
   echo '```'
-  awk '/^node /{p = 1} p' "$out/$fit.log"
+  awk '/^node +type/{p = 1} p' "$out/$fit.log"
   echo '```'
 done
