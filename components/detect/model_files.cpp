@@ -19,15 +19,17 @@ std::filesystem::path model_cache_dir() {
   return cache / "mocap" / "models";
 }
 
-std::filesystem::path movenet_model_json() {
-  const auto dir = model_cache_dir() / "movenet-multipose";
-  const auto json = dir / "movenet-multipose.json";
+std::filesystem::path cached_model_json(std::string_view name) {
+  const auto dir = model_cache_dir() / name;
+  const std::string stem(name);
+  const auto json = dir / (stem + ".json");
   if (!std::filesystem::is_regular_file(json) ||
-      !std::filesystem::is_regular_file(dir / "movenet-multipose.bin")) {
-    throw ModelMissing("MoveNet MultiPose model not found in " + dir.string() +
-                       "; run tools/setup.sh --models-only to fetch it (or set MOCAP_MODEL_DIR)");
+      !std::filesystem::is_regular_file(dir / (stem + ".bin"))) {
+    throw ModelMissing("model " + stem + " not found in " + dir.string() + "; " + kFetchModelsHint);
   }
   return json;
 }
+
+std::filesystem::path movenet_model_json() { return cached_model_json("movenet-multipose"); }
 
 }  // namespace mocap::detect

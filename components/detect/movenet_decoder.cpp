@@ -18,17 +18,18 @@ constexpr int kPeakWindow = 5;
 
 float sigmoid(float v) { return 1.0f / (1.0f + std::exp(-v)); }
 
+// A head, NHWC without the batch: value (c, y, x) at [(y * width + x) * channels + c].
 class Grid {
  public:
-  Grid(const std::vector<float>& data, int height, int width)
-      : data_(data), h_(height), w_(width) {}
+  Grid(const std::vector<float>& data, int width, int channels)
+      : data_(data), w_(width), c_(channels) {}
   float at(int channel, int y, int x) const {
-    return data_[(static_cast<std::size_t>(channel) * h_ + y) * w_ + x];
+    return data_[(static_cast<std::size_t>(y) * w_ + x) * c_ + channel];
   }
 
  private:
   const std::vector<float>& data_;
-  int h_, w_;
+  int w_, c_;
 };
 
 void check_size(const std::vector<float>& head, int channels, const MovenetHeads& heads,
@@ -77,7 +78,8 @@ struct Instance {
 
 Instance make_instance(const MovenetHeads& heads, int cell, float score) {
   const int h = heads.height, w = heads.width;
-  const Grid bs(heads.box_scale, h, w), bo(heads.box_offset, h, w), kr(heads.regress, h, w);
+  const Grid bs(heads.box_scale, w, 2), bo(heads.box_offset, w, 2),
+      kr(heads.regress, w, 2 * kMovenetKeypoints);
   Instance in;
   in.cy = cell / w;
   in.cx = cell % w;
@@ -131,7 +133,7 @@ Cell best_cell(const Instance& in, int k, const Grid& heat, float denom) {
 MovenetRow make_row(const std::vector<Instance>& all, std::size_t i, const MovenetHeads& heads,
                     float denom) {
   const int h = heads.height, w = heads.width;
-  const Grid heat(heads.heatmap, h, w), ko(heads.offset, h, w);
+  const Grid heat(heads.heatmap, w, kMovenetKeypoints), ko(heads.offset, w, 2 * kMovenetKeypoints);
   const Instance& in = all[i];
   MovenetRow row{};
   float sum = 0.0f;

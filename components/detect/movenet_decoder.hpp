@@ -15,8 +15,8 @@ inline constexpr int kMovenetKeypoints = 17;  // COCO-17 order
 inline constexpr int kMovenetInstances = 6;
 inline constexpr int kMovenetRowSize = 3 * kMovenetKeypoints + 5;  // 56
 
-// The heads on the stride-4 grid (height × width cells), channel-major: value (c, y, x) at
-// [(c * height + y) * width + x], as cv::dnn returns them (NCHW without the batch).
+// The heads on the stride-4 grid (height × width cells), channels last: value (c, y, x) at
+// [(y * width + x) * channels + c], as TensorFlow gives them (NHWC without the batch).
 struct MovenetHeads {
   int height = 0, width = 0;
   std::vector<float> center;      // 1 channel: person-centre logit

@@ -44,6 +44,13 @@ int to_rgb_code(PixelFormat format) {
   return -1;
 }
 
+RunnerOptions runner_options(const MovenetOptions& options) {
+  RunnerOptions r;
+  r.backend = options.backend;
+  r.threads = options.threads;
+  return r;
+}
+
 }  // namespace
 
 MovenetInput prepare_movenet_input(const ImageBuffer& image, int input_size) {
@@ -81,14 +88,13 @@ MovenetInput prepare_movenet_input(const ImageBuffer& image, int input_size) {
 
 MovenetDetector::MovenetDetector(const std::filesystem::path& model_json,
                                  const MovenetOptions& options)
-    : options_((check_input_size(options.input_size), options)), network_(model_json) {
-  if (options_.threads > 0) cv::setNumThreads(options_.threads);
-}
+    : options_((check_input_size(options.input_size), options)),
+      network_(model_json, runner_options(options)) {}
 
 std::vector<MovenetPerson> MovenetDetector::detect(const ImageBuffer& image) {
   const MovenetInput input = prepare_movenet_input(image, options_.input_size);
-  return select_people(decode_movenet(network_.run(input.tensor)), input.mapping,
-                       options_.thresholds);
+  network_.run(input.tensor, heads_);
+  return select_people(decode_movenet(heads_), input.mapping, options_.thresholds);
 }
 
 }  // namespace mocap::detect

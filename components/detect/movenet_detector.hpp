@@ -18,8 +18,9 @@ struct MovenetOptions {
   // fastest useful size; 384-512 find small or distant people.
   int input_size = 256;
   MovenetThresholds thresholds;
-  // cv::dnn threads, 0 for OpenCV's default. OpenCV's setting is process-wide: the last detector
-  // made decides.
+  // The network runtime and its threads (graph_runner.hpp): XNNPACK threads are the detector's
+  // own; cv::dnn's are process-wide (the last detector made decides). 0: the runtime's default.
+  Backend backend = Backend::automatic;
   int threads = 0;
 };
 
@@ -42,10 +43,12 @@ class MovenetDetector {
   std::vector<MovenetPerson> detect(const ImageBuffer& image);
 
   const MovenetOptions& options() const { return options_; }
+  Backend backend() const { return network_.backend(); }
 
  private:
   MovenetOptions options_;
   MovenetNetwork network_;
+  MovenetHeads heads_;  // reused from frame to frame
 };
 
 }  // namespace mocap::detect

@@ -3,12 +3,6 @@
 #include <array>
 #include <stdexcept>
 #include <string>
-#include <vector>
-
-#include <opencv2/core.hpp>
-#include <opencv2/dnn.hpp>
-
-#include "detect/tfjs_graph.hpp"
 
 namespace mocap::detect {
 namespace {
@@ -26,39 +20,42 @@ constexpr std::array<int, 6> kHeadChannels = {
     1, 2, 2, kMovenetKeypoints, 2 * kMovenetKeypoints, 2 * kMovenetKeypoints};
 constexpr int kStride = 4, kSizeMultiple = 32;
 
-cv::dnn::Net load_net(const std::filesystem::path& model_json) {
-  const std::string graph = tfjs_to_graphdef(model_json, kHeadNodes);
-  try {
-    return cv::dnn::readNetFromTensorflow(graph.data(), graph.size());
-  } catch (const cv::Exception& e) {
-    throw std::runtime_error("cv::dnn could not import " + model_json.string() + ": " + e.what());
+// RGB values 0..255 as float NHWC (the graph normalises them itself).
+void to_rgb_floats(const ImageBuffer& image, std::vector<float>& out) {
+  const int w = image.width(), h = image.height();
+  out.resize(static_cast<std::size_t>(w) * h * 3);
+  const bool bgr = image.format() == PixelFormat::bgr8;
+  float* o = out.data();
+  for (int y = 0; y < h; ++y) {
+    const auto* row = reinterpret_cast<const unsigned char*>(
+        image.data() + static_cast<std::size_t>(y) * static_cast<std::size_t>(image.stride()));
+    for (int x = 0; x < w; ++x, row += 3, o += 3) {
+      o[0] = row[bgr ? 2 : 0];
+      o[1] = row[1];
+      o[2] = row[bgr ? 0 : 2];
+    }
   }
-}
-
-std::vector<float> to_vector(const cv::Mat& blob) {
-  const cv::Mat contiguous = blob.isContinuous() ? blob : blob.clone();
-  const auto* p = contiguous.ptr<float>();
-  return {p, p + contiguous.total()};
 }
 
 }  // namespace
 
-struct MovenetNetwork::Impl {
-  cv::dnn::Net net;
-  std::vector<cv::String> outputs;
-};
-
-MovenetNetwork::MovenetNetwork(const std::filesystem::path& model_json)
-    : impl_(std::make_unique<Impl>()) {
-  impl_->net = load_net(model_json);
-  for (const std::string& head : kHeadNodes) impl_->outputs.push_back(fused_conv_layer_name(head));
-}
+MovenetNetwork::MovenetNetwork(const std::filesystem::path& model_json,
+                               const RunnerOptions& options)
+    : runner_(make_graph_runner(model_json, kHeadNodes, options)) {}
 
 MovenetNetwork::~MovenetNetwork() = default;
 MovenetNetwork::MovenetNetwork(MovenetNetwork&&) noexcept = default;
 MovenetNetwork& MovenetNetwork::operator=(MovenetNetwork&&) noexcept = default;
 
+Backend MovenetNetwork::backend() const { return runner_->backend(); }
+
 MovenetHeads MovenetNetwork::run(const ImageBuffer& tensor) {
+  MovenetHeads heads;
+  run(tensor, heads);
+  return heads;
+}
+
+void MovenetNetwork::run(const ImageBuffer& tensor, MovenetHeads& heads) {
   const PixelFormat format = tensor.format();
   if (format != PixelFormat::rgb8 && format != PixelFormat::bgr8)
     throw std::invalid_argument("MoveNet input must be rgb8 or bgr8, got " +
@@ -66,29 +63,21 @@ MovenetHeads MovenetNetwork::run(const ImageBuffer& tensor) {
   if (tensor.width() % kSizeMultiple || tensor.height() % kSizeMultiple || tensor.empty())
     throw std::invalid_argument("MoveNet input size " + std::to_string(tensor.width()) + "x" +
                                 std::to_string(tensor.height()) + " is not a multiple of 32");
-  const cv::Mat view(tensor.height(), tensor.width(), CV_8UC3,
-                     const_cast<std::byte*>(tensor.data()),
-                     static_cast<std::size_t>(tensor.stride()));
-  // The graph normalises 0..255 itself; it wants RGB.
-  const cv::Mat blob = cv::dnn::blobFromImage(view, 1.0, cv::Size(), cv::Scalar(),
-                                              format == PixelFormat::bgr8, false, CV_32F);
-  impl_->net.setInput(blob);
-  std::vector<cv::Mat> outs;
-  impl_->net.forward(outs, impl_->outputs);
+  to_rgb_floats(tensor, input_);
+  const std::array<std::int64_t, 4> shape = {1, tensor.height(), tensor.width(), 3};
+  runner_->run({shape, input_}, outputs_);
 
-  MovenetHeads heads;
   heads.height = tensor.height() / kStride;
   heads.width = tensor.width() / kStride;
-  std::array<std::vector<float>*, 6> targets = {&heads.center,  &heads.box_scale, &heads.box_offset,
-                                                &heads.heatmap, &heads.regress,   &heads.offset};
+  const std::array<std::vector<float>*, 6> targets = {&heads.center,     &heads.box_scale,
+                                                      &heads.box_offset, &heads.heatmap,
+                                                      &heads.regress,    &heads.offset};
   for (std::size_t i = 0; i < targets.size(); ++i) {
-    const cv::Mat& out = outs[i];
-    if (out.dims != 4 || out.size[1] != kHeadChannels[i] || out.size[2] != heads.height ||
-        out.size[3] != heads.width)
+    const GraphTensor& out = outputs_[i];
+    if (out.shape != std::vector<std::int64_t>{1, heads.height, heads.width, kHeadChannels[i]})
       throw std::runtime_error("MoveNet head " + kHeadNodes[i] + " has an unexpected shape");
-    *targets[i] = to_vector(out);
+    targets[i]->swap(outputs_[i].values);  // the runner refills its vector next time
   }
-  return heads;
 }
 
 }  // namespace mocap::detect

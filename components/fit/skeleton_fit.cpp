@@ -9,15 +9,12 @@
 #include <glm/mat3x3.hpp>
 #include <glm/matrix.hpp>
 
+#include "fit/frame_setup.hpp"
 #include "fit/window_problem.hpp"
 
 namespace mocap::fit {
 
-using detail::Bones;
-using detail::FrameData;
-using detail::FrameVars;
-using detail::kBones;
-using detail::WindowFrame;
+using namespace detail;
 
 Body FittedFrame::root_relative() const {
   Body out = joints;
@@ -99,24 +96,6 @@ Body with_bone_lengths(const Body& retrieved, const BoneLengths& bones) {
 
 namespace {
 
-Bones to_bones(const BoneLengths& b) {
-  Bones out{};
-  for (int j = 0; j < kBones; ++j) out[j] = b.m[j];
-  return out;
-}
-
-BoneLengths from_bones(const Bones& b) {
-  BoneLengths out;
-  for (int j = 0; j < kBones; ++j) out.m[j] = b[j];
-  return out;
-}
-
-bool usable(const BoneLengths& b) {
-  for (int j = 0; j < kBones; ++j)
-    if (!(b.m[j] > 0.0) || !std::isfinite(b.m[j])) return false;
-  return true;
-}
-
 // The person's 2D size (pixels): the larger side of the present keypoints' box.
 double person_size_px(const recon::BodyXyc& k, double min_confidence) {
   double x0 = std::numeric_limits<double>::max(), x1 = -x0, y0 = x0, y1 = -x0;
@@ -137,10 +116,30 @@ bool finite_body(const Body& b) {
   return true;
 }
 
+}  // namespace
+
+namespace detail {
+
+Bones to_bones(const BoneLengths& b) {
+  Bones out{};
+  for (int j = 0; j < kBones; ++j) out[j] = b.m[j];
+  return out;
+}
+
+BoneLengths from_bones(const Bones& b) {
+  BoneLengths out;
+  for (int j = 0; j < kBones; ++j) out.m[j] = b[j];
+  return out;
+}
+
+bool usable(const BoneLengths& b) {
+  for (int j = 0; j < kBones; ++j)
+    if (!(b.m[j] > 0.0) || !std::isfinite(b.m[j])) return false;
+  return true;
+}
+
 bool observed(const FrameInput& in) { return in.retrieved_valid && finite_body(in.retrieved); }
 
-// The constants of a frame; `reference` supplies the bone directions when the frame has no
-// retrieved pose of its own.
 FrameData frame_data(const FrameInput& in, const Body& reference, const FitOptions& options) {
   FrameData d;
   d.observed = observed(in);
@@ -180,7 +179,6 @@ BoneLengths initial_bones(std::span<const FrameInput> frames, const FitOptions& 
   return median_bone_lengths(poses);
 }
 
-// Initial translation of an observed frame; nullopt when the keypoints cannot give one.
 std::optional<glm::dvec3> start_translation(const FrameInput& in, const BoneLengths& bones,
                                             const FitOptions& options) {
   Body pose = with_bone_lengths(in.retrieved, bones);
@@ -191,7 +189,15 @@ std::optional<glm::dvec3> start_translation(const FrameInput& in, const BoneLeng
   return std::nullopt;
 }
 
-}  // namespace
+void count(FitStats& stats, const WindowSummary& solve) {
+  ++stats.solves;
+  stats.iterations += solve.iterations;
+  stats.frame_iterations += static_cast<double>(solve.variable_frames) * solve.iterations;
+  stats.initial_cost += solve.initial_cost;
+  stats.final_cost += solve.final_cost;
+}
+
+}  // namespace detail
 
 FitResult fit_sequence(std::span<const FrameInput> frames, const FitOptions& options) {
   FitResult result;
@@ -247,7 +253,7 @@ FitResult fit_sequence(std::span<const FrameInput> frames, const FitOptions& opt
   const Bones initial = bones;
   const auto summary = detail::solve_window(window, bones, initial, options,
                                             {options.solve_bones, options.max_iterations});
-  result.stats = {1, summary.iterations, summary.initial_cost, summary.final_cost};
+  count(result.stats, summary);
   result.bones = from_bones(bones);
   for (std::size_t i = 0; i < frames.size(); ++i)
     result.frames[i] = output(vars[i], data[i], bones, true);
@@ -336,10 +342,7 @@ std::optional<FittedFrame> LiveFitter::push(const FrameInput& frame) {
     const auto summary =
         detail::solve_window(frames, s.bones, s.bones, s.options,
                              {false, s.options.live_iterations, s.options.lag == 0});
-    ++s.stats.solves;
-    s.stats.iterations += summary.iterations;
-    s.stats.initial_cost += summary.initial_cost;
-    s.stats.final_cost += summary.final_cost;
+    count(s.stats, summary);
   }
   // Emit the frame that is now `lag` frames old.
   if (s.pushed <= static_cast<std::size_t>(s.options.lag)) return std::nullopt;

@@ -114,6 +114,9 @@ struct FittedFrame {
 struct FitStats {
   int solves = 0;
   int iterations = 0;
+  // Σ over solves of (frames solved × iterations): the work, which grows with a window's length
+  // times its iterations (a per-frame cost that does not grow with a track's length is linear).
+  double frame_iterations = 0.0;
   double initial_cost = 0.0, final_cost = 0.0;  // sums over solves
 };
 
@@ -134,8 +137,54 @@ std::optional<glm::dvec3> initial_translation(const Body& pose, const recon::Bod
 // `retrieved` rebuilt with `bones`: every bone keeps its direction and gets its length.
 Body with_bone_lengths(const Body& retrieved, const BoneLengths& bones);
 
-// Full-sequence mode: every frame of `frames` in one problem (bone lengths shared).
+// Full-sequence mode: every frame of `frames` in one problem (bone lengths shared). The reference
+// for the windowed mode below (mocap-bench-fit compares them); its cost grows faster than the
+// length (docs/fitting.md, "Speed").
 FitResult fit_sequence(std::span<const FrameInput> frames, const FitOptions& options);
+
+// Windowed full mode (offline, streaming): a person's frames are solved in overlapping windows of
+// `frames` frames; each window is solved after the two frames emitted before it (frozen: they
+// anchor the smoothness and contact terms), and all its frames but the last `overlap` are
+// emitted: those are final. The overlap frames start the next window from their solution. The
+// first window also solves the bone lengths (FitOptions::solve_bones); they are fixed afterwards,
+// so every output has the same skeleton. A track shorter than a window is one solve, the same as
+// fit_sequence. Cost: linear in the track's length (each frame is solved in at most
+// ceil(frames / (frames - overlap)) windows). Chosen on CMU train clips: docs/fitting.md.
+struct WindowOptions {
+  int frames = 64;
+  int overlap = 16;
+};
+
+// A limit on a solve: a stop's quick finish. seconds <= 0: nothing is solved (frames invalid).
+struct SolveBudget {
+  int iterations = 5;
+  double seconds = 0.1;
+};
+
+class WindowedFitter {
+ public:
+  explicit WindowedFitter(FitOptions options, WindowOptions window = {});
+  ~WindowedFitter();
+  WindowedFitter(WindowedFitter&&) noexcept;
+  WindowedFitter& operator=(WindowedFitter&&) noexcept;
+
+  // Adds the next frame; returns the frames that became final (in order; usually none, a
+  // window's worth when one was solved). solve = false only holds the frame (a stop is under
+  // way: finish() solves what is held within a budget).
+  std::vector<FittedFrame> push(const FrameInput& frame, bool solve = true);
+  // The frames still held, solved as a last window and returned in order; frames after the last
+  // observed one are returned invalid, unsolved. With a budget: at most its iterations and time.
+  std::vector<FittedFrame> finish(std::optional<SolveBudget> budget = std::nullopt);
+  // The floor from now on (a ground estimated while running); nullopt: no ground term.
+  void set_ground(std::optional<GroundPlane> ground);
+  const BoneLengths& bones() const;  // the initial ones until the first window is solved
+  const FitStats& stats() const;
+  std::size_t held() const;  // frames pushed and not returned yet
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
 
 // Fixed-lag live mode: push frames one at a time; each push solves the newest lag + 1 frames
 // (warm-started: the held-back frames keep their values, the new one starts from its retrieved

@@ -54,10 +54,12 @@ struct WindowSolve {
   bool solve_bones = false;
   int max_iterations = 20;
   bool velocity_smoothing = false;  // first differences instead of second ones
+  double max_seconds = 0.0;         // > 0: the solve stops after this long (a stop's quick solve)
 };
 
 struct WindowSummary {
   int iterations = 0;
+  int variable_frames = 0;
   double initial_cost = 0.0, final_cost = 0.0;
 };
 

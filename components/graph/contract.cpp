@@ -43,8 +43,40 @@ void Contract::add_output(PortSpec port) {
 void Contract::add_param(ParamSpec param) {
   if (find_param(param.name))
     throw std::logic_error("parameter '" + param.name + "' declared twice");
-  if (param.fallback) check_range(param, *param.fallback);
+  if (!param.choices.empty() && param.type != ParamType::string)
+    throw std::logic_error("parameter '" + param.name + "': only strings have choices");
+  if (param.fallback) check_value(param, *param.fallback);
   params_.push_back(std::move(param));
+}
+
+bool Contract::is_joined(std::string_view input) const {
+  return join_ && std::find(join_->ports.begin(), join_->ports.end(), input) != join_->ports.end();
+}
+
+void Contract::join(JoinSpec spec) {
+  if (join_) throw std::logic_error("join() declared twice (one join per node)");
+  if (spec.ports.empty()) throw std::logic_error("join() needs the inputs it joins");
+  for (const std::string& port : spec.ports) {
+    if (input_index(port) < 0) {
+      throw std::logic_error("join() of unknown input '" + port + "' (declare inputs first)");
+    }
+  }
+  param_choice("sync_by", spec.key == SyncKey::frame ? "frame" : "capture_time",
+               {"frame", "capture_time"},
+               "joined inputs: what the messages of one set share (frame: the frame number, "
+               "offline; capture_time: capture times within sync_tolerance_ms, live)");
+  param<std::int64_t>("sync_bound", spec.bound,
+                      "joined inputs: messages held per input while their set waits for the "
+                      "others (docs/graph-files.md, 'Joined inputs')",
+                      {1, 1e6});
+  param<double>("sync_tolerance_ms", spec.tolerance_ms,
+                "joined inputs, capture_time: how far apart the capture times of one set may be",
+                {0.0, 1e6});
+  param<double>("sync_wait_ms", spec.wait_ms,
+                "joined inputs: a set still incomplete after this wall-clock wait goes on "
+                "partial; 0: no limit",
+                {0.0, 1e7});
+  join_ = std::move(spec);
 }
 
 void Contract::network_socket(std::string endpoint_param, std::string bind_param) {
@@ -52,9 +84,9 @@ void Contract::network_socket(std::string endpoint_param, std::string bind_param
   param<std::string>("curve_server", "",
                      "CURVE: the binding end's key file (NAME.key where it binds, NAME.pub where "
                      "it connects); required beyond loopback (docs/security.md)");
-  param<std::string>("curve_client", "",
-                     "CURVE: the client key files (binding: NAME.pub or folders of *.pub, "
-                     "comma-separated, the only clients let in; connecting: its own NAME.key)");
+  param_list<std::string>("curve_client", {},
+                          "CURVE: the client key files (binding: NAME.pub or folders of *.pub, "
+                          "the only clients let in; connecting: its own NAME.key)");
   network_ = NetworkSocket{std::move(endpoint_param), std::move(bind_param)};
 }
 

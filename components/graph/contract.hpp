@@ -3,6 +3,7 @@
 // types and parameters with type, default, range and a one-line doc. The framework checks graphs
 // against contracts before any node runs, and `mocap graph inspect` prints them.
 
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -18,11 +19,29 @@ struct PortSpec {
   std::string same_as;    // outputs: carries the type of this input (pass-through nodes)
   bool optional = false;  // inputs: may stay unconnected
   std::string doc;
+  // Inputs only: a repeated input takes min_count..max_count edges, wired to name:0, name:1, ...
+  bool repeated = false;
+  std::size_t min_count = 1, max_count = 1;
 
   bool any() const { return type.empty() && same_as.empty(); }
 };
 
 enum class PortFlag { required, optional };
+
+// What the inputs of a set are matched by (graph/synchronizer.hpp).
+enum class SyncKey { frame, capture_time };
+
+// A node's joined inputs: process() is called once per set of messages that belong together (the
+// same frame number, or capture times within a tolerance) instead of once per message. The
+// contract gives the defaults of the parameters that tune it (sync_by, sync_bound,
+// sync_tolerance_ms, sync_wait_ms), which a graph can override like any other.
+struct JoinSpec {
+  std::vector<std::string> ports;  // input names; a repeated input joins all its edges
+  SyncKey key = SyncKey::frame;
+  std::int64_t bound = 64;  // messages held per port at most
+  double tolerance_ms = 0;  // capture_time: how far apart the messages of one set may be
+  double wait_ms = 0;       // a partial set goes on after this wall-clock wait; 0: never
+};
 
 class Contract {
  public:
@@ -40,6 +59,20 @@ class Contract {
   void input_any(std::string name, std::string doc = {}, PortFlag flag = PortFlag::required) {
     add_input(PortSpec{std::move(name), {}, {}, flag == PortFlag::optional, std::move(doc)});
   }
+  // A repeated input: a graph wires min_count..max_count edges to it as name:0, name:1, ... (no
+  // gaps); the node reads them with ctx.input<T>(name, i) and ctx.input_count(name). With
+  // min_count 0 it may stay unconnected.
+  template <class T>
+  void inputs(std::string name, std::string doc, std::size_t min_count, std::size_t max_count) {
+    add_input(PortSpec{std::move(name),
+                       std::string(T::kTypeName),
+                       {},
+                       min_count == 0,
+                       std::move(doc),
+                       true,
+                       min_count,
+                       max_count});
+  }
 
   template <class T>
   void output(std::string name, std::string doc = {}) {
@@ -52,14 +85,51 @@ class Contract {
 
   template <class T>
   void param(std::string name, T fallback, std::string doc, Range range = {}) {
-    add_param(
-        ParamSpec{std::move(name), param_type_of<T>(), to_value(fallback), range, std::move(doc)});
+    add_param(ParamSpec{
+        std::move(name), param_type_of<T>(), false, {}, to_value(fallback), range, std::move(doc)});
   }
   // A parameter every graph must set (a file path, an endpoint).
   template <class T>
   void required_param(std::string name, std::string doc, Range range = {}) {
-    add_param(ParamSpec{std::move(name), param_type_of<T>(), std::nullopt, range, std::move(doc)});
+    add_param(ParamSpec{
+        std::move(name), param_type_of<T>(), false, {}, std::nullopt, range, std::move(doc)});
   }
+  // A string limited to `choices`; graph validation names the allowed values and the nearest one.
+  void param_choice(std::string name, std::string fallback, std::vector<std::string> choices,
+                    std::string doc) {
+    add_param(ParamSpec{std::move(name),
+                        ParamType::string,
+                        false,
+                        std::move(choices),
+                        ParamValue(std::move(fallback)),
+                        {},
+                        std::move(doc)});
+  }
+  // A list of values (a YAML sequence in a graph file, a comma list with --set); read it with
+  // ctx.param<std::vector<T>>(name). Ranges apply to every item.
+  template <class T>
+  void param_list(std::string name, std::vector<T> fallback, std::string doc, Range range = {}) {
+    static_assert(param_type_of<T>() != ParamType::boolean, "lists of bool are not supported");
+    add_param(ParamSpec{
+        std::move(name), param_type_of<T>(), true, {}, to_list(fallback), range, std::move(doc)});
+  }
+  // A list whose items are each one of `choices`.
+  void param_choice_list(std::string name, std::vector<std::string> fallback,
+                         std::vector<std::string> choices, std::string doc) {
+    add_param(ParamSpec{std::move(name),
+                        ParamType::string,
+                        true,
+                        std::move(choices),
+                        ParamValue(std::move(fallback)),
+                        {},
+                        std::move(doc)});
+  }
+
+  // Joins the named inputs (JoinSpec above): process() sees one set per call, each input of it
+  // present or missing (ctx.has). Declare the inputs first; one join per node.
+  void join(JoinSpec spec);
+  const std::optional<JoinSpec>& joined() const { return join_; }
+  bool is_joined(std::string_view input) const;
 
   // The node opens a ZeroMQ socket itself, at the endpoint in parameter `endpoint_param`; it binds
   // unless `bind_param` names a bool parameter set to false. This adds the parameters
@@ -106,6 +176,16 @@ class Contract {
       return ParamValue(std::string(v));
     }
   }
+  template <class T>
+  static ParamValue to_list(const std::vector<T>& items) {
+    if constexpr (param_type_of<T>() == ParamType::integer) {
+      return ParamValue(std::vector<std::int64_t>(items.begin(), items.end()));
+    } else if constexpr (param_type_of<T>() == ParamType::number) {
+      return ParamValue(std::vector<double>(items.begin(), items.end()));
+    } else {
+      return ParamValue(std::vector<std::string>(items.begin(), items.end()));
+    }
+  }
   // These throw std::logic_error on duplicate names or a bad same_as: a bug in the node's code.
   void add_input(PortSpec port);
   void add_output(PortSpec port);
@@ -117,6 +197,7 @@ class Contract {
   bool auxiliary_ = false;
   std::optional<NetworkSocket> network_;
   std::string http_host_param_;
+  std::optional<JoinSpec> join_;
 };
 
 }  // namespace mocap::graph

@@ -88,14 +88,17 @@ class Reader {
       }
     }
   }
+  // node.port, or node.port:INDEX for an edge of a repeated input.
   PortRef port_ref(const YAML::Node& node) const {
     const std::string text = scalar(node, "an edge end");
-    const auto dot = text.find('.');
-    if (dot == std::string::npos || dot == 0 || dot + 1 == text.size() ||
-        text.find('.', dot + 1) != std::string::npos) {
-      fail(node, "edge end '" + text + "' must be written node.port");
+    static const std::regex pattern(R"(([^.:]+)\.([^.:]+)(?::(\d{1,6}))?)");
+    std::smatch match;
+    if (!std::regex_match(text, match, pattern)) {
+      fail(node, "edge end '" + text +
+                     "' must be written node.port (or node.port:N for edge N "
+                     "of a repeated input)");
     }
-    return {text.substr(0, dot), text.substr(dot + 1)};
+    return {match[1].str(), match[2].str(), match[3].matched ? std::stoi(match[3].str()) : -1};
   }
 
   NodeSpec node(const std::string& name, const YAML::Node& body) const {
@@ -109,12 +112,26 @@ class Reader {
     if (const YAML::Node params = body["params"]) {
       if (params.IsNull()) return spec;
       expect_map(params, "params of node '" + name + "'");
-      for (const auto& item : params) {
-        spec.params[item.first.Scalar()] = ParamText{
-            scalar(item.second, "parameter '" + item.first.Scalar() + "'"), at(item.second)};
-      }
+      for (const auto& item : params) spec.params[item.first.Scalar()] = param(item);
     }
     return spec;
+  }
+
+  // A single value, or a YAML sequence of single values for a list parameter.
+  template <class Item>
+  ParamText param(const Item& item) const {
+    const std::string name = item.first.Scalar();
+    ParamText text{{}, at(item.second)};
+    if (!item.second.IsSequence()) {
+      text.text = scalar(item.second, "parameter '" + name + "'");
+      return text;
+    }
+    text.is_list = true;
+    for (const auto& value : item.second) {
+      text.items.push_back(scalar(value, "an item of parameter '" + name + "'"));
+      text.text += (text.text.empty() ? "" : ",") + text.items.back();
+    }
+    return text;
   }
 
   void edge_options(const YAML::Node& options, EdgeSpec& edge) const {

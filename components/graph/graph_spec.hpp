@@ -32,9 +32,19 @@ struct EdgePolicy {
 // "blocking", "blocking(64)", "latest", "drop_oldest", "drop_oldest(4)"; nullopt when malformed.
 std::optional<EdgePolicy> parse_policy(std::string_view text);
 
+// "view" or "view:2": an input and, for a repeated one, the edge index (index < 0: none). Built
+// by appending: GCC 12 warns (-Wrestrict, a false positive) on ":" + std::to_string(i).
+inline std::string indexed_port(std::string_view port, long index) {
+  std::string text(port);
+  if (index >= 0) text.append(":").append(std::to_string(index));
+  return text;
+}
+
 struct PortRef {
   std::string node, port;
-  std::string str() const { return node + "." + port; }
+  int index = -1;  // edge index of a repeated input ("solve.view:2"); -1: none written
+
+  std::string str() const { return node + "." + indexed_port(port, index); }
 };
 
 // ZeroMQ CURVE of an edge (`curve: { server: keys/solve, client: keys/capture }`): key file
@@ -60,8 +70,10 @@ struct EdgeSpec {
 };
 
 struct ParamText {
-  std::string text;
+  std::string text;  // a single value, or a comma list (--set) for a list parameter
   SourceLocation where;
+  bool is_list = false;  // written as a YAML sequence: the items are in `items`
+  std::vector<std::string> items{};
 };
 
 struct NodeSpec {

@@ -37,26 +37,61 @@ bool Inbox::push(std::size_t port_index, Packet packet) {
   return true;
 }
 
+std::size_t Inbox::oldest(const std::vector<bool>* readable) const {
+  std::size_t best = ports_.size();
+  for (std::size_t i = 0; i < ports_.size(); ++i) {
+    const Port& port = ports_[i];
+    if (port.items.empty() || (readable && !(*readable)[i])) continue;
+    if (best == ports_.size() || port.items.front().arrival < ports_[best].items.front().arrival) {
+      best = i;
+    }
+  }
+  return best;
+}
+
+// Called with the lock held; notifies producers after unlocking is left to the caller.
+Inbox::Delivery Inbox::take(std::size_t index) {
+  Port& port = ports_[index];
+  Delivery delivery{index, std::move(port.items.front().packet)};
+  port.items.pop_front();
+  if (!delivery.packet.is_end_of_stream()) --port.data_items;
+  --depth_;
+  return delivery;
+}
+
 std::optional<Inbox::Delivery> Inbox::pop() {
   std::unique_lock lock(mutex_);
   readable_.wait(lock, [&] { return closed_ || depth_ > 0; });
   if (closed_) return std::nullopt;
-  Port* oldest = nullptr;
-  std::size_t oldest_index = 0;
-  for (std::size_t i = 0; i < ports_.size(); ++i) {
-    Port& port = ports_[i];
-    if (port.items.empty()) continue;
-    if (!oldest || port.items.front().arrival < oldest->items.front().arrival) {
-      oldest = &port;
-      oldest_index = i;
-    }
-  }
-  Delivery delivery{oldest_index, std::move(oldest->items.front().packet)};
-  oldest->items.pop_front();
-  if (!delivery.packet.is_end_of_stream()) --oldest->data_items;
-  --depth_;
+  Delivery delivery = take(oldest(nullptr));
   lock.unlock();
   writable_.notify_all();  // producers of different ports share the condition
+  return delivery;
+}
+
+Inbox::Waited Inbox::pop(const std::vector<bool>& readable,
+                         std::optional<std::chrono::steady_clock::time_point> deadline) {
+  std::unique_lock lock(mutex_);
+  const auto ready = [&] { return closed_ || oldest(&readable) < ports_.size(); };
+  if (deadline) {
+    if (!readable_.wait_until(lock, *deadline, ready)) return {};
+  } else {
+    readable_.wait(lock, ready);
+  }
+  if (closed_) return {std::nullopt, true};
+  Delivery delivery = take(oldest(&readable));
+  lock.unlock();
+  writable_.notify_all();
+  return {std::move(delivery), false};
+}
+
+std::optional<Inbox::Delivery> Inbox::try_pop(const std::vector<bool>& readable) {
+  std::unique_lock lock(mutex_);
+  const std::size_t port = oldest(&readable);
+  if (closed_ || port == ports_.size()) return std::nullopt;
+  Delivery delivery = take(port);
+  lock.unlock();
+  writable_.notify_all();
   return delivery;
 }
 

@@ -6,6 +6,7 @@
 //   drop_oldest(N)  N slots; when full the oldest waiting message is dropped (counted)
 // End of stream is never dropped and never waits: it is always queued behind the data.
 
+#include <chrono>
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
@@ -33,6 +34,20 @@ class Inbox {
   // Waits for the oldest waiting message of any port; nullopt once the inbox is closed.
   std::optional<Delivery> pop();
 
+  // Waits for the oldest waiting message of the ports marked in `readable` (a port left out keeps
+  // its messages, and a blocking edge into it fills and makes its producer wait), until
+  // `deadline` (none: no limit). `closed` says the inbox was closed; otherwise no delivery means
+  // the deadline passed.
+  struct Waited {
+    std::optional<Delivery> delivery;
+    bool closed = false;
+  };
+  Waited pop(const std::vector<bool>& readable,
+             std::optional<std::chrono::steady_clock::time_point> deadline);
+  // Without waiting: the oldest message of the readable ports, if any.
+  std::optional<Delivery> try_pop(const std::vector<bool>& readable);
+  std::size_t ports() const { return ports_.size(); }
+
   // The node will not read any more: wakes every waiter, further pushes are discarded.
   void close();
 
@@ -45,6 +60,10 @@ class Inbox {
     Packet packet;
     std::uint64_t arrival;
   };
+  // The port whose front is oldest among the readable ones; ports_.size() when none.
+  std::size_t oldest(const std::vector<bool>* readable) const;
+  Delivery take(std::size_t port);
+
   struct Port {
     EdgePolicy policy;
     std::deque<Item> items;

@@ -176,14 +176,7 @@ CurveKeys load_curve_keys(const std::string& server, const std::vector<std::stri
 CurveKeys node_curve_keys(const Context& ctx, bool binds) {
   const std::string server = ctx.param<std::string>("curve_server");
   if (server.empty()) return {};
-  const std::string list = ctx.param<std::string>("curve_client");
-  std::vector<std::string> clients;
-  for (std::size_t start = 0; start <= list.size();) {
-    const std::size_t end = std::min(list.find(',', start), list.size());
-    if (end > start) clients.push_back(list.substr(start, end - start));
-    start = end + 1;
-  }
-  return load_curve_keys(server, clients, binds);
+  return load_curve_keys(server, ctx.param<std::vector<std::string>>("curve_client"), binds);
 }
 
 WrittenKeyPair write_key_pair(const std::string& name, const fs::path& dir, bool force) {

@@ -1,23 +1,29 @@
 #pragma once
 // The node API. A node type is a class with a static contract() and the lifecycle
-// open / process / close; MOCAP_REGISTER_NODE (registry.hpp) makes it available by name:
+// open / process / close; MOCAP_REGISTER_NODE (registry.hpp) makes it available by name. A real
+// one, components/nodes/recon/smooth_1euro.cpp, shortened:
 //
-//   class Smoother : public Node {
+//   class Smooth1EuroNode : public Node {
 //    public:
 //     static void contract(Contract& c) {
+//       c.doc("Smooths each person's 3D joints with the 1-Euro filter (online)");
 //       c.input<People3D>("in");
 //       c.output<People3D>("out");
-//       c.param<double>("beta", 0.4, "1-Euro cutoff slope", {0.0, 10.0});
+//       c.param<double>("beta", 0.4, "cutoff slope", {0.0, 100.0});
 //     }
-//     void open(Context& ctx) override { filter_.set_beta(ctx.param<double>("beta")); }
-//     void process(Context& ctx) override { ctx.send("out",
-//     filter_.apply(ctx.input<People3D>("in"))); }
+//     void open(Context& ctx) override { params_.beta = ctx.param<double>("beta"); }
+//     void process(Context& ctx) override {
+//       People3D out = ctx.input<People3D>("in");
+//       ...  // recon::OneEuroFilterVec3 per person and joint (the library does the work)
+//       ctx.send("out", std::move(out));
+//     }
 //    private:
-//     recon::OneEuro filter_;
+//     recon::OneEuroParams params_;
 //   };
-//   MOCAP_REGISTER_NODE("recon.smooth_1euro", Smoother);
+//   MOCAP_REGISTER_NODE("recon.smooth_1euro", Smooth1EuroNode)
 //
 // Threading: each node runs on its own thread, so a node's members need no locks.
+// docs/node-authoring.md says more, including how to test a node alone (graph/harness.hpp).
 
 #include <chrono>
 #include <memory>
@@ -25,6 +31,7 @@
 #include <string>
 #include <string_view>
 #include <type_traits>
+#include <vector>
 
 #include "graph/contract.hpp"
 #include "graph/packet.hpp"
@@ -43,16 +50,28 @@ class Context {
   template <class T>
   T param(std::string_view name) const;
 
-  // --- inputs: process() is called once per arriving message, for exactly one input port.
+  // --- inputs. process() is called once per arriving message, for exactly one input port; for a
+  // node whose contract joins inputs (Contract::join), once per set of the joined inputs, each
+  // present or missing (has). A repeated input's edges are read by index (0..input_count - 1).
+  // The port of the single message being processed; for a set, the first joined input present.
   virtual std::string_view input_port() const = 0;  // empty in sources
-  bool has(std::string_view port) const { return input_port() == port; }
+  bool has(std::string_view port, std::size_t index = 0) const {
+    return find_input(port, index) != nullptr;
+  }
+  // Edges wired to `port`: 0 or 1 for a plain input, N for a repeated one.
+  virtual std::size_t input_count(std::string_view port) const = 0;
+  // True while process() handles a set of joined inputs.
+  virtual bool in_set() const = 0;
   template <class T>
-  const T& input(std::string_view port) const {
-    return *input_ptr<T>(port);
+  const T& input(std::string_view port, std::size_t index = 0) const {
+    return *input_ptr<T>(port, index);
   }
   template <class T>
-  std::shared_ptr<const T> input_ptr(std::string_view port) const;
-  const Header& header() const { return current(input_port()).header(); }
+  std::shared_ptr<const T> input_ptr(std::string_view port, std::size_t index = 0) const;
+  const Header& header() const {
+    if (const Header* h = input_header()) return *h;
+    throw std::logic_error("node '" + node_name() + "': no input message in this call");
+  }
 
   // --- outputs. A message whose header is empty (no stream, no capture time) inherits the
   // header of the input being processed, so stages after a source rarely touch headers.
@@ -86,9 +105,12 @@ class Context {
 
   virtual GraphStats stats() const = 0;
 
-  // The primitives the helpers above are made of (and what a test harness implements).
+  // The primitives the helpers above are made of.
   virtual const Header* input_header() const = 0;  // of the message being processed, or null
-  virtual const Packet& current(std::string_view port) const = 0;
+  // The message of `port` (edge `index` of a repeated input) in this call, or null.
+  virtual const Packet* find_input(std::string_view port, std::size_t index = 0) const = 0;
+  // As find_input, but throws (a bug in the node) when the port holds no message in this call.
+  const Packet& current(std::string_view port, std::size_t index = 0) const;
   virtual void send_packet(std::string_view port, Packet packet) = 0;
   virtual const ParamValue& param_value(std::string_view name) const = 0;
 };
@@ -98,11 +120,16 @@ class Node {
   virtual ~Node() = default;
   virtual void open(Context&) {}
   // Sources (no inputs) are called in a loop until they call ctx.finish() or the graph stops;
-  // other nodes once per input message.
+  // other nodes once per input message, or once per set of their joined inputs.
   virtual void process(Context& ctx) = 0;
   // Called after the last message (also when the graph is stopped): flush files here.
   virtual void close(Context&) {}
 };
+
+template <class T>
+struct is_vector : std::false_type {};
+template <class T>
+struct is_vector<std::vector<T>> : std::true_type {};
 
 template <class T>
 T Context::param(std::string_view name) const {
@@ -114,6 +141,15 @@ T Context::param(std::string_view name) const {
   } else if constexpr (std::is_floating_point_v<T>) {
     if (const auto* v = std::get_if<double>(&value)) return static_cast<T>(*v);
     if (const auto* v = std::get_if<std::int64_t>(&value)) return static_cast<T>(*v);
+  } else if constexpr (std::is_same_v<T, std::vector<std::string>>) {
+    if (const auto* v = std::get_if<std::vector<std::string>>(&value)) return *v;
+  } else if constexpr (std::is_same_v<T, std::vector<double>> ||
+                       std::is_same_v<T, std::vector<float>>) {
+    if (const auto* v = std::get_if<std::vector<double>>(&value)) return T(v->begin(), v->end());
+  } else if constexpr (is_vector<T>::value) {
+    if (const auto* v = std::get_if<std::vector<std::int64_t>>(&value)) {
+      return T(v->begin(), v->end());
+    }
   } else {
     if (const auto* v = std::get_if<std::string>(&value)) return T(*v);
   }
@@ -121,9 +157,16 @@ T Context::param(std::string_view name) const {
                          "' read with the wrong type");
 }
 
+inline const Packet& Context::current(std::string_view port, std::size_t index) const {
+  if (const Packet* packet = find_input(port, index)) return *packet;
+  throw std::logic_error("node '" + node_name() + "': input '" + std::string(port) +
+                         (index ? ":" + std::to_string(index) : std::string()) +
+                         "' holds no message in this call (check ctx.has first)");
+}
+
 template <class T>
-std::shared_ptr<const T> Context::input_ptr(std::string_view port) const {
-  const Packet& packet = current(port);
+std::shared_ptr<const T> Context::input_ptr(std::string_view port, std::size_t index) const {
+  const Packet& packet = current(port, index);
   if (packet.type != T::kTypeName) {
     throw std::logic_error("node '" + node_name() + "': input '" + std::string(port) + "' holds " +
                            std::string(packet.type) + ", read as " + std::string(T::kTypeName));

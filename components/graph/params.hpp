@@ -1,6 +1,9 @@
 #pragma once
-// Typed node parameters: declared by a node's contract (type, default, range, one-line doc),
-// given in graph files or on the command line as text, checked before any node starts.
+// Typed node parameters: declared by a node's contract (type, default, range or allowed values,
+// one-line doc), given in graph files or on the command line as text, checked before any node
+// starts. A parameter is a single value or a list of values of one type (a YAML sequence in a
+// graph file, a comma list on the command line); a string parameter may be limited to a fixed set
+// of choices.
 
 #include <cstdint>
 #include <optional>
@@ -8,14 +11,17 @@
 #include <string_view>
 #include <type_traits>
 #include <variant>
+#include <vector>
 
 namespace mocap::graph {
 
 enum class ParamType { boolean, integer, number, string };
 
-using ParamValue = std::variant<bool, std::int64_t, double, std::string>;
+using ParamValue = std::variant<bool, std::int64_t, double, std::string, std::vector<std::int64_t>,
+                                std::vector<double>, std::vector<std::string>>;
 
 std::string_view name(ParamType type);
+// Single values as written in a graph file; lists as a comma list ("1,2,3").
 std::string to_text(const ParamValue& value);
 
 template <class T>
@@ -34,23 +40,34 @@ constexpr ParamType param_type_of() {
 }
 
 struct Range {
-  std::optional<double> min, max;  // inclusive; numbers and integers only
+  std::optional<double> min, max;  // inclusive; numbers and integers only (each item of a list)
 };
 
 struct ParamSpec {
   std::string name;
-  ParamType type = ParamType::string;
+  ParamType type = ParamType::string;  // of the value, or of each item of a list
+  bool list = false;
+  std::vector<std::string> choices{};  // strings only: the allowed values; empty: any
   std::optional<ParamValue> fallback;  // empty: the parameter is required
-  Range range;
-  std::string doc;
+  Range range{};
+  std::string doc{};
 
   bool required() const { return !fallback.has_value(); }
+  // "int", "choice of live, full, off", "list of number", ...
+  std::string type_text() const;
 };
 
-// Parses `text` as the declared type and checks the range. Throws std::invalid_argument with a
-// message that names the parameter and says what was expected.
+// Parses `text` as the declared type and checks the range or the choices; a list parameter takes
+// a comma list. Throws std::invalid_argument with a message that names the parameter and says
+// what was expected (for a choice, the allowed values and the nearest one to what was written).
 ParamValue parse_param(const ParamSpec& spec, std::string_view text);
-// Checks an already typed value (a default) against the range; same errors as parse_param.
-void check_range(const ParamSpec& spec, const ParamValue& value);
+// A list parameter given as separate items (a YAML sequence); same checks and errors.
+ParamValue parse_param_items(const ParamSpec& spec, const std::vector<std::string>& items);
+// Checks an already typed value (a default) against the range and choices; same errors.
+void check_value(const ParamSpec& spec, const ParamValue& value);
+
+// The candidate nearest to `word` by edit distance when it is a likely typo (at most a third of
+// the word's letters differ), else empty: for "did you mean" in error messages.
+std::string nearest(std::string_view word, const std::vector<std::string>& candidates);
 
 }  // namespace mocap::graph

@@ -10,6 +10,7 @@
 
 #include "graph/inbox.hpp"
 #include "graph/keys.hpp"
+#include "graph/node_inputs.hpp"
 #include "graph/sequence_check.hpp"
 #include "graph/transport.hpp"
 
@@ -140,12 +141,12 @@ class NodeRunner final : public Context {
   };
 
   NodeRunner(Runtime::Impl& runtime, const ResolvedNode& node, std::vector<EdgePolicy> policies,
-             std::size_t connected_inputs)
+             AtBound at_bound)
       : runtime_(runtime),
         node_(node),
         contract_(node.type->contract),
-        inbox_(std::move(policies)),
-        connected_inputs_(connected_inputs),
+        inputs_(node.type->contract, node.input_counts, std::move(policies), node.params, at_bound),
+        inbox_(inputs_.inbox()),
         outputs_(node.type->contract.outputs().size()) {
     for (std::size_t i = 0; i < outputs_.size(); ++i) outputs_[i].type = node.output_types[i];
     instance_ = node.type->create();
@@ -191,6 +192,10 @@ class NodeRunner final : public Context {
     s.p95_us = p95;
     s.queue_depth = inbox_.depth();
     s.max_queue_depth = inbox_.max_depth();
+    {
+      const std::lock_guard lock(status_mutex_);  // the synchroniser's counters change as it runs
+      s.sync = sync_stats_;
+    }
     static constexpr const char* kStates[] = {"waiting", "running", "done", "failed"};
     s.state = kStates[state_.load()];
     {
@@ -202,18 +207,13 @@ class NodeRunner final : public Context {
 
   // --- Context
   const std::string& node_name() const override { return node_.name; }
-  std::string_view input_port() const override {
-    return current_ ? std::string_view(contract_.inputs()[current_port_].name) : std::string_view();
+  std::string_view input_port() const override { return inputs_.port_name(); }
+  const Packet* find_input(std::string_view port, std::size_t index) const override {
+    return inputs_.find(port, index);
   }
-  const Packet& current(std::string_view port) const override {
-    if (!current_ || contract_.inputs()[current_port_].name != port) {
-      throw std::logic_error("node '" + node_.name + "': input '" + std::string(port) +
-                             "' holds no message in this call (it is for '" +
-                             std::string(input_port()) + "')");
-    }
-    return *current_;
-  }
-  const Header* input_header() const override { return current_ ? &current_->header() : nullptr; }
+  std::size_t input_count(std::string_view port) const override { return inputs_.count(port); }
+  bool in_set() const override { return inputs_.in_set(); }
+  const Header* input_header() const override { return inputs_.header(); }
   void send_packet(std::string_view port, Packet packet) override;
   void count_drop() override { ++own_drops_; }
   void report_status(std::string text) override {
@@ -246,6 +246,7 @@ class NodeRunner final : public Context {
   void run();
   void run_source();
   void run_consumer();
+  void publish_sync_stats(bool now);
   void timed_process();
   void end_outputs();
   // The end of stream this node sends: its header names the stream and, as seq, how many
@@ -253,7 +254,7 @@ class NodeRunner final : public Context {
   // that messages are missing at the end (a killed peer). A node that sent nothing passes on the
   // header of the end of stream it received.
   Packet end_of_stream(const Output& out) const {
-    if (!out.sent_any) return Packet::end_of_stream(received_end_);
+    if (!out.sent_any) return Packet::end_of_stream(inputs_.received_end());
     Header header = out.last_sent;
     ++header.seq;
     return Packet::end_of_stream(std::move(header));
@@ -269,17 +270,16 @@ class NodeRunner final : public Context {
   const ResolvedNode& node_;
   const Contract& contract_;
   std::unique_ptr<Node> instance_;
-  Inbox inbox_;
-  std::size_t connected_inputs_;
+  NodeInputs inputs_;
+  Inbox& inbox_;
   std::vector<Output> outputs_;
   bool blocks_auxiliary_ = false;
   std::thread thread_;
 
-  const Packet* current_ = nullptr;
-  std::size_t current_port_ = 0;
   bool finished_ = false, failed_ = false;
-  Header received_end_;  // the header of an end of stream that arrived
   Clock::duration slept_{};
+  SyncStats sync_stats_;  // under status_mutex_
+  Clock::time_point sync_published_{};
 
   std::atomic<std::uint64_t> in_{0}, out_{0}, own_drops_{0};
   std::uint64_t abandoned_at_stop_ = 0;  // data left in the inbox after the drain deadline
@@ -329,26 +329,39 @@ void NodeRunner::run_source() {
 }
 
 void NodeRunner::run_consumer() {
-  std::size_t ended = 0;
-  if (connected_inputs_ == 0) return;  // only optional, unconnected inputs: nothing will come
-  while (auto delivery = inbox_.pop()) {
-    if (delivery->packet.is_end_of_stream()) {
-      if (!delivery->packet.header().stream.empty()) received_end_ = delivery->packet.header();
-      if (++ended == connected_inputs_) return;
-      continue;
-    }
-    ++in_;
+  while (inputs_.next(true) == NodeInputs::Step::call) {
+    in_ = inputs_.received();
     // A stop bounds the drain: once its deadline has passed, what is still queued is counted
     // (a drop, and a log line at the end) instead of processed, so the graph exits in time.
     if (runtime_.abandon_queued()) {
-      ++abandoned_at_stop_;
-      ++own_drops_;
+      for (const Packet& packet : inputs_.current()) {
+        if (!packet.message) continue;
+        ++abandoned_at_stop_;
+        ++own_drops_;
+      }
       continue;
     }
-    current_port_ = delivery->port;
-    current_ = &delivery->packet;
     timed_process();
-    current_ = nullptr;
+    publish_sync_stats(false);
+  }
+  in_ = inputs_.received();
+  publish_sync_stats(true);
+}
+
+// The synchroniser's counters for snapshots taken on other threads: copied at most every 100 ms
+// while the node runs (not per message), and once at the end.
+void NodeRunner::publish_sync_stats(bool now) {
+  const Synchronizer* sync = inputs_.synchronizer();
+  if (!sync) return;
+  const auto time = Clock::now();
+  if (!now && time - sync_published_ < std::chrono::milliseconds(100)) return;
+  sync_published_ = time;
+  const std::vector<NodeInputs::SlotName> slots = inputs_.joined_slots();
+  const std::lock_guard lock(status_mutex_);
+  sync_stats_ = sync->stats();
+  for (std::size_t i = 0; i < slots.size(); ++i) {
+    sync_stats_.inputs[i].name =
+        indexed_port(slots[i].port, slots[i].repeated ? static_cast<long>(slots[i].index) : -1);
   }
 }
 
@@ -366,7 +379,7 @@ void NodeRunner::run() {
   } catch (const std::exception& e) {
     record_failure(opened ? "process" : "open", e.what());
   }
-  current_ = nullptr;
+  inputs_.clear();
   inbox_.close();
   if (abandoned_at_stop_ > 0) {
     runtime_.log("node '" + node_.name + "': " + std::to_string(abandoned_at_stop_) +
@@ -401,6 +414,50 @@ void NodeRunner::end_outputs() {
 
 // --- building the runtime
 
+namespace {
+
+// The inbox slot of an edge's end: a node's inputs in contract order, a repeated one taking one
+// slot per edge (NodeInputs).
+std::size_t input_slot(const ResolvedNode& node, const PortRef& to) {
+  const auto input = static_cast<std::size_t>(node.type->contract.input_index(to.port));
+  std::size_t slot = 0;
+  for (std::size_t i = 0; i < input; ++i) slot += node.input_counts[i];
+  return slot + static_cast<std::size_t>(std::max(to.index, 0));
+}
+
+// True when two of the node's joined edges have a node upstream in common (the 2D people and,
+// behind a slower chain, their 3D): a synchroniser that waited with one input full would make
+// that common node wait, which may starve the other input for good. Such joins pass the oldest
+// set on partial at the bound instead (graph/synchronizer.hpp). Independent sources wait.
+bool joins_branches_of_one_source(const ResolvedGraph& graph, const ResolvedNode& node) {
+  const Contract& contract = node.type->contract;
+  if (!contract.joined()) return false;
+  const auto upstream_of = [&](const std::string& start) {
+    std::set<std::string> seen{start};
+    std::vector<std::string> todo{start};
+    while (!todo.empty()) {
+      const std::string current = todo.back();
+      todo.pop_back();
+      for (const EdgeSpec& edge : graph.spec.edges) {
+        if (edge.to.node == current && seen.insert(edge.from.node).second) {
+          todo.push_back(edge.from.node);
+        }
+      }
+    }
+    return seen;
+  };
+  std::set<std::string> seen;
+  for (const EdgeSpec& edge : graph.spec.edges) {
+    if (edge.to.node != node.name || !contract.is_joined(edge.to.port)) continue;
+    for (const std::string& upstream : upstream_of(edge.from.node)) {
+      if (!seen.insert(upstream).second) return true;
+    }
+  }
+  return false;
+}
+
+}  // namespace
+
 NodeRunner* Runtime::Impl::runner(std::string_view name) const {
   for (const auto& r : runners) {
     if (r->resolved().name == name) return r.get();
@@ -434,8 +491,7 @@ void Runtime::Impl::add_receiving_half(const EdgeSpec& edge) {
       std::make_unique<Receiver>(transport, edge.transport, socket_options(edge, true));
   incoming_edge->consumer = to;
   incoming_edge->inbox = &to->inbox();
-  incoming_edge->port =
-      static_cast<std::size_t>(to->resolved().type->contract.input_index(edge.to.port));
+  incoming_edge->port = input_slot(to->resolved(), edge.to);
   incoming.push_back(std::move(incoming_edge));
 }
 
@@ -455,9 +511,7 @@ void Runtime::Impl::add_sending_half(const EdgeSpec& edge) {
     throw std::runtime_error(edge.where.str() + ": edge " + edge.str() +
                              " crosses processes without a transport");
   }
-  out.local.emplace_back(
-      &to->inbox(),
-      static_cast<std::size_t>(to->resolved().type->contract.input_index(edge.to.port)));
+  out.local.emplace_back(&to->inbox(), input_slot(to->resolved(), edge.to));
 }
 
 void Runtime::Impl::build() {
@@ -468,15 +522,15 @@ void Runtime::Impl::build() {
   }
   for (const ResolvedNode& node : graph.nodes) {
     if (!options.process.empty() && node.process != options.process) continue;
-    const Contract& contract = node.type->contract;
-    std::vector<EdgePolicy> policies(contract.inputs().size());
-    std::size_t connected = 0;
+    std::size_t slots = 0;
+    for (std::size_t count : node.input_counts) slots += count;
+    std::vector<EdgePolicy> policies(slots);
     for (const EdgeSpec& edge : graph.spec.edges) {
-      if (edge.to.node != node.name) continue;
-      policies[static_cast<std::size_t>(contract.input_index(edge.to.port))] = edge.policy;
-      ++connected;
+      if (edge.to.node == node.name) policies[input_slot(node, edge.to)] = edge.policy;
     }
-    runners.push_back(std::make_unique<NodeRunner>(*this, node, std::move(policies), connected));
+    const AtBound at_bound =
+        joins_branches_of_one_source(graph, node) ? AtBound::pass_partial : AtBound::wait;
+    runners.push_back(std::make_unique<NodeRunner>(*this, node, std::move(policies), at_bound));
   }
   // Every receiving end binds before any sender connects (inproc:// wants the binder first).
   for (const EdgeSpec& edge : graph.spec.edges) add_receiving_half(edge);

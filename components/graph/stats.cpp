@@ -33,6 +33,19 @@ std::array<double, 2> LatencyWindow::percentiles_us() const {
   return {percentile(copy, 50) / 1000.0, percentile(copy, 95) / 1000.0};
 }
 
+std::string format_sync_stats(const SyncStats& sync) {
+  if (sync.inputs.empty()) return {};
+  std::ostringstream out;
+  out << "joined " << sync.sets << " sets (" << sync.complete << " complete)";
+  if (sync.restarts) out << ", " << sync.restarts << " restarts";
+  for (const SyncInputStats& input : sync.inputs) {
+    out << "; " << input.name << ": " << input.missing << " missing";
+    if (input.late) out << ", " << input.late << " late";
+    if (input.held) out << ", " << input.held << " held";
+  }
+  return out.str();
+}
+
 std::string format_stats_table(const GraphStats& stats) {
   std::ostringstream out;
   char line[256];
@@ -47,6 +60,7 @@ std::string format_stats_table(const GraphStats& stats) {
                   n.p50_us, n.p95_us, n.queue_depth, n.max_queue_depth, n.state.c_str());
     out << line;
     if (!n.status.empty()) out << "  " << n.node << ": " << n.status << "\n";
+    if (!n.sync.inputs.empty()) out << "  " << n.node << ": " << format_sync_stats(n.sync) << "\n";
   }
   return out.str();
 }

@@ -14,6 +14,30 @@
 
 namespace mocap::graph {
 
+// The synchroniser of a node with joined inputs (graph/synchronizer.hpp).
+struct SyncInputStats {
+  std::string name;            // the input ("people3d", "view:2"); set by the runtime
+  std::uint64_t received = 0;  // messages (not end of stream) taken in
+  std::uint64_t missing = 0;   // sets passed on without a message of this input
+  std::uint64_t late = 0;      // messages that came after their set had gone on (passed alone)
+  std::size_t held = 0, max_held = 0;
+  bool ended = false;
+
+  bool operator==(const SyncInputStats&) const = default;
+};
+
+struct SyncStats {
+  std::uint64_t sets = 0;              // passed on, late ones included
+  std::uint64_t complete = 0;          // sets with every input present
+  std::uint64_t restarts = 0;          // an input's stream went back (a restarted producer)
+  std::vector<SyncInputStats> inputs;  // empty: the node joins nothing
+
+  bool operator==(const SyncStats&) const = default;
+};
+
+// One line: "sets 795 (790 complete); people3d: 5 missing, 2 late; ..."; empty when not joined.
+std::string format_sync_stats(const SyncStats& sync);
+
 struct NodeStats {
   std::string node, type, process;
   std::uint64_t in = 0, out = 0, drops = 0;
@@ -21,6 +45,7 @@ struct NodeStats {
   std::size_t queue_depth = 0, max_queue_depth = 0;
   std::string state;   // "running", "done", "failed"
   std::string status;  // the node's latest status line (Context::report_status), e.g. a reconnect
+  SyncStats sync{};    // joined inputs only; in-process (not in the wire format's GraphStats)
 
   bool operator==(const NodeStats&) const = default;
 };

@@ -20,6 +20,41 @@ const ResolvedNode* ResolvedGraph::find(std::string_view name) const {
   return nullptr;
 }
 
+std::map<std::string, ParamValue> resolve_params(const NodeSpec& spec, const Contract& contract,
+                                                 std::vector<std::string>& errors) {
+  std::map<std::string, ParamValue> params;
+  const auto error = [&](const SourceLocation& where, const std::string& what) {
+    errors.push_back(where.str() + ": " + what);
+  };
+  for (const auto& [name, text] : spec.params) {
+    const ParamSpec* param = contract.find_param(name);
+    if (!param) {
+      std::vector<std::string> known;
+      for (const ParamSpec& p : contract.params()) known.push_back(p.name);
+      const std::string near = nearest(name, known);
+      error(text.where, "node '" + spec.name + "' (" + spec.type + ") has no parameter '" + name +
+                            "'" + (near.empty() ? "" : "; did you mean '" + near + "'?"));
+      continue;
+    }
+    try {
+      params[name] =
+          text.is_list ? parse_param_items(*param, text.items) : parse_param(*param, text.text);
+    } catch (const std::invalid_argument& e) {
+      error(text.where, "node '" + spec.name + "': " + e.what());
+    }
+  }
+  for (const ParamSpec& param : contract.params()) {
+    if (params.count(param.name) || spec.params.count(param.name)) continue;
+    if (param.required()) {
+      error(spec.where, "node '" + spec.name + "' (" + spec.type + ") needs parameter '" +
+                            param.name + "' (" + param.doc + ")");
+    } else {
+      params[param.name] = *param.fallback;
+    }
+  }
+  return params;
+}
+
 namespace {
 
 class Checker {
@@ -75,11 +110,16 @@ class Checker {
       }
       node.type = registry_.find(spec.type);
       if (!node.type) {
-        error(spec.where, "node '" + spec.name + "': unknown node type '" + spec.type +
-                              "' (see 'mocap graph inspect')");
+        std::vector<std::string> known;
+        for (const NodeType* type : registry_.all()) known.push_back(type->name);
+        const std::string near = nearest(spec.type, known);
+        error(spec.where, "node '" + spec.name + "': unknown node type '" + spec.type + "' (" +
+                              (near.empty() ? "" : "did you mean '" + near + "'? ") +
+                              "see 'mocap graph inspect')");
       } else {
         resolve_params(spec, node);
         node.input_types.resize(node.type->contract.inputs().size());
+        node.input_counts.resize(node.type->contract.inputs().size());
         node.output_types.resize(node.type->contract.outputs().size());
       }
       node.process = spec_.process_of(spec.name);
@@ -88,29 +128,7 @@ class Checker {
   }
 
   void resolve_params(const NodeSpec& spec, ResolvedNode& node) {
-    const Contract& contract = node.type->contract;
-    for (const auto& [name, text] : spec.params) {
-      const ParamSpec* param = contract.find_param(name);
-      if (!param) {
-        error(text.where,
-              "node '" + spec.name + "' (" + spec.type + ") has no parameter '" + name + "'");
-        continue;
-      }
-      try {
-        node.params[name] = parse_param(*param, text.text);
-      } catch (const std::invalid_argument& e) {
-        error(text.where, "node '" + spec.name + "': " + e.what());
-      }
-    }
-    for (const ParamSpec& param : contract.params()) {
-      if (node.params.count(param.name) || spec.params.count(param.name)) continue;
-      if (param.required()) {
-        error(spec.where, "node '" + spec.name + "' (" + spec.type + ") needs parameter '" +
-                              param.name + "' (" + param.doc + ")");
-      } else {
-        node.params[param.name] = *param.fallback;
-      }
-    }
+    node.params = graph::resolve_params(spec, node.type->contract, errors_);
   }
 
   int node_index(const std::string& name) const {
@@ -149,11 +167,70 @@ class Checker {
       const int out = port_index(edge, edge.from, true);
       const int in = port_index(edge, edge.to, false);
       if (out < 0 || in < 0) continue;
+      if (edge.from.index >= 0) {
+        error(edge.where, "edge " + edge.str() + ": an output takes no index (" + edge.from.node +
+                              "." + edge.from.port + ")");
+        continue;
+      }
+      ResolvedNode& to = nodes_[static_cast<std::size_t>(node_index(edge.to.node))];
+      const PortSpec& port = to.type->contract.inputs()[static_cast<std::size_t>(in)];
+      if (port.repeated && edge.to.index < 0) {
+        error(edge.where, "edge " + edge.str() + ": " + edge.to.str() +
+                              " is a repeated input: wire each edge to an index, " + edge.to.str() +
+                              ":0, " + edge.to.str() + ":1, ...");
+        continue;
+      }
+      if (!port.repeated && edge.to.index >= 0) {
+        error(edge.where, "edge " + edge.str() + ": input " + edge.to.node + "." + edge.to.port +
+                              " takes one edge, without an index");
+        continue;
+      }
       if (const auto [it, fresh] = input_used.emplace(edge.to.str(), &edge); !fresh) {
         error(edge.where, "input " + edge.to.str() + " is already fed by the edge at " +
                               it->second->where.str() + " (one edge per input)");
+        continue;
       }
+      ++to.input_counts[static_cast<std::size_t>(in)];
       valid_edges_.push_back(&edge);
+    }
+    check_repeated_inputs();
+  }
+
+  // A repeated input's edges are numbered 0..N-1 without gaps, with N within its bounds.
+  void check_repeated_inputs() {
+    for (const ResolvedNode& node : nodes_) {
+      if (!node.type) continue;
+      const Contract& c = node.type->contract;
+      for (std::size_t i = 0; i < c.inputs().size(); ++i) {
+        const PortSpec& port = c.inputs()[i];
+        if (!port.repeated) continue;
+        std::vector<const EdgeSpec*> by_index;
+        for (const EdgeSpec* edge : valid_edges_) {
+          if (edge->to.node != node.name || edge->to.port != port.name) continue;
+          const auto index = static_cast<std::size_t>(edge->to.index);
+          if (by_index.size() <= index) by_index.resize(index + 1, nullptr);
+          by_index[index] = edge;
+        }
+        const std::string name = node.name + "." + port.name;
+        for (std::size_t k = 0; k < by_index.size(); ++k) {
+          if (by_index[k]) continue;
+          const EdgeSpec* after = *std::find_if(by_index.begin() + static_cast<std::ptrdiff_t>(k),
+                                                by_index.end(), [](auto* e) { return e; });
+          error(after->where, "input " + indexed_port(name, static_cast<long>(k)) +
+                                  " is not connected, but " + after->to.str() +
+                                  " is (number the edges of " + name + " 0.." +
+                                  std::to_string(node.input_counts[i] - 1) + " without gaps)");
+          break;
+        }
+        const std::size_t n = node.input_counts[i];
+        if (n < port.min_count || n > port.max_count) {
+          const SourceLocation& where =
+              by_index.empty() ? spec_.find_node(node.name)->where : by_index.back()->where;
+          error(where, "input " + name + " takes " + std::to_string(port.min_count) + " to " +
+                           std::to_string(port.max_count) + " edges (" + name + ":0.." +
+                           std::to_string(port.max_count - 1) + "), not " + std::to_string(n));
+        }
+      }
     }
   }
 
@@ -161,7 +238,7 @@ class Checker {
     for (const ResolvedNode& node : nodes_) {
       if (!node.type) continue;
       for (const PortSpec& port : node.type->contract.inputs()) {
-        if (port.optional) continue;
+        if (port.optional || port.repeated) continue;
         const bool connected = std::any_of(
             spec_.edges.begin(), spec_.edges.end(),
             [&](const EdgeSpec& e) { return e.to.node == node.name && e.to.port == port.name; });
@@ -395,7 +472,7 @@ class Checker {
       }
       // Key references: relative ones against the graph file's folder (--set: the current one).
       std::vector<std::string> clients;
-      std::string server, joined;
+      std::string server;
       bool references_ok = true;
       const auto resolve_one = [&](const std::string& param, std::string reference) {
         const auto first = reference.find_first_not_of(" \t");
@@ -414,12 +491,11 @@ class Checker {
       if (const std::string server_text = text("curve_server"); !server_text.empty()) {
         server = resolve_one("curve_server", server_text);
       }
-      const std::string client_text = text("curve_client");
-      for (std::size_t start = 0; !client_text.empty() && start <= client_text.size();) {
-        const std::size_t end = std::min(client_text.find(',', start), client_text.size());
-        clients.push_back(resolve_one("curve_client", client_text.substr(start, end - start)));
-        joined += (joined.empty() ? "" : ",") + clients.back();
-        start = end + 1;
+      if (const auto it = node.params.find("curve_client"); it != node.params.end()) {
+        if (const auto* items = std::get_if<std::vector<std::string>>(&it->second)) {
+          for (const std::string& item : *items)
+            clients.push_back(resolve_one("curve_client", item));
+        }
       }
       if (!references_ok) continue;
       const bool curve = !server.empty();
@@ -430,7 +506,7 @@ class Checker {
         continue;
       }
       node.params["curve_server"] = server;
-      node.params["curve_client"] = joined;
+      node.params["curve_client"] = clients;
       const Endpoint endpoint = endpoint_of(endpoint_text);
       if (endpoint.inproc && curve) {
         error(where("curve_server"),
@@ -510,8 +586,9 @@ std::string to_dot(const ResolvedGraph& graph) {
   for (const EdgeSpec& e : graph.spec.edges) {
     const ResolvedNode* from = graph.find(e.from.node);
     const auto port = static_cast<std::size_t>(from->type->contract.output_index(e.from.port));
+    const std::string to_port = indexed_port(e.to.port, e.to.index);
     out << "  \"" << e.from.node << "\" -> \"" << e.to.node << "\" [label=\"" << e.from.port
-        << " -> " << e.to.port << "\\n"
+        << " -> " << to_port << "\\n"
         << from->output_types[port] << ", " << e.policy.str()
         << (e.transport.empty() ? "" : "\\n" + e.transport) << "\""
         << (e.policy.lossy() ? ", style=dashed" : "") << "];\n";
@@ -533,8 +610,21 @@ std::string describe(const NodeType& type) {
   out << "\n  inputs:\n";
   if (c.inputs().empty()) out << "    (none: a source)\n";
   for (const auto& p : c.inputs()) {
-    out << "    " << p.name << " : " << port_type(p) << (p.optional ? " (optional)" : "")
-        << (p.doc.empty() ? "" : "  " + p.doc) << "\n";
+    out << "    " << p.name;
+    if (p.repeated) {
+      out << ":0..N : " << port_type(p) << " (" << p.min_count << " to " << p.max_count
+          << " edges)";
+    } else {
+      out << " : " << port_type(p) << (p.optional ? " (optional)" : "");
+    }
+    out << (c.is_joined(p.name) ? " (joined)" : "") << (p.doc.empty() ? "" : "  " + p.doc) << "\n";
+  }
+  if (const auto& join = c.joined()) {
+    std::string ports;
+    for (const std::string& port : join->ports) ports += (ports.empty() ? "" : " + ") + port;
+    out << "    joined: " << ports << ", one set per "
+        << (join->key == SyncKey::frame ? "frame number" : "capture time")
+        << " (parameters sync_*)\n";
   }
   out << "\n  outputs:\n";
   if (c.outputs().empty()) out << "    (none: a sink)\n";
@@ -544,7 +634,7 @@ std::string describe(const NodeType& type) {
   out << "\n  parameters:\n";
   if (c.params().empty()) out << "    (none)\n";
   for (const auto& p : c.params()) {
-    out << "    " << p.name << " : " << name(p.type);
+    out << "    " << p.name << " : " << p.type_text();
     if (p.fallback) {
       out << " = " << to_text(*p.fallback);
     } else {

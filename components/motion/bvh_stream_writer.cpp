@@ -42,11 +42,16 @@ BvhStreamWriter::BvhStreamWriter(std::string path, Skeleton skeleton, double fra
     throw std::invalid_argument("BvhStreamWriter: the skeleton has no channels (" + path_ + ")");
   if (!(frame_time > 0.0) || !std::isfinite(frame_time))
     throw std::invalid_argument("BvhStreamWriter: frame time must be positive (" + path_ + ")");
-  // The file appears with its whole header or not at all: the header is written to PATH.part,
-  // which is then renamed to PATH (a kill in between leaves no PATH, or the old one). A special
-  // file (/dev/null, /dev/full) is written in place.
+  // The file appears with its whole header or not at all. A new file is written unnamed
+  // (O_TMPFILE) and linked as PATH with its first frame (or at close): a kill at any moment leaves
+  // no PATH, or one with frames, and no temporary file. An existing file is replaced by writing
+  // PATH.part and renaming it (a kill in between leaves the old PATH and PATH.part); so is a new
+  // one where the file system has no unnamed files. A special file (/dev/null, /dev/full) is
+  // written in place.
   struct stat existing {};
-  const bool special = ::stat(path_.c_str(), &existing) == 0 && !S_ISREG(existing.st_mode);
+  const bool exists = ::stat(path_.c_str(), &existing) == 0;
+  const bool special = exists && !S_ISREG(existing.st_mode);
+  if (!exists && create_unnamed(frame_time)) return;
   const std::string part = special ? path_ : path_ + ".part";
   fd_ = ::open(part.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd_ < 0) throw InputError(path_, error_text("cannot create the BVH file"));
@@ -61,6 +66,29 @@ BvhStreamWriter::BvhStreamWriter(std::string path, Skeleton skeleton, double fra
   }
 }
 
+bool BvhStreamWriter::create_unnamed(double frame_time) {
+  const std::size_t slash = path_.rfind('/');
+  const std::string folder = slash == std::string::npos ? "." : path_.substr(0, slash + 1);
+  fd_ = ::open(folder.c_str(), O_TMPFILE | O_WRONLY | O_CLOEXEC, 0644);
+  if (fd_ < 0) return false;  // no unnamed files here (or no folder): the .part way says why
+  try {
+    write_header(frame_time);
+  } catch (...) {
+    release();
+    throw;
+  }
+  unnamed_ = true;
+  return true;
+}
+
+void BvhStreamWriter::link_unnamed() {
+  if (!unnamed_) return;
+  const std::string self = "/proc/self/fd/" + std::to_string(fd_);
+  if (::linkat(AT_FDCWD, self.c_str(), AT_FDCWD, path_.c_str(), AT_SYMLINK_FOLLOW) != 0)
+    throw InputError(path_, error_text("cannot create the BVH file"));
+  unnamed_ = false;
+}
+
 BvhStreamWriter::BvhStreamWriter(BvhStreamWriter&& other) noexcept
     : path_(std::move(other.path_)),
       skeleton_(std::move(other.skeleton_)),
@@ -68,7 +96,8 @@ BvhStreamWriter::BvhStreamWriter(BvhStreamWriter&& other) noexcept
       count_offset_(other.count_offset_),
       end_(other.end_),
       frames_(other.frames_),
-      suspended_(std::exchange(other.suspended_, false)) {}
+      suspended_(std::exchange(other.suspended_, false)),
+      unnamed_(std::exchange(other.unnamed_, false)) {}
 
 BvhStreamWriter& BvhStreamWriter::operator=(BvhStreamWriter&& other) noexcept {
   if (this != &other) {
@@ -80,14 +109,24 @@ BvhStreamWriter& BvhStreamWriter::operator=(BvhStreamWriter&& other) noexcept {
     end_ = other.end_;
     frames_ = other.frames_;
     suspended_ = std::exchange(other.suspended_, false);
+    unnamed_ = std::exchange(other.unnamed_, false);
   }
   return *this;
 }
 
-BvhStreamWriter::~BvhStreamWriter() { release(); }
+// A file still unnamed (no frame yet) is linked now, as close() would: it was asked for.
+BvhStreamWriter::~BvhStreamWriter() {
+  try {
+    link_unnamed();
+  } catch (const InputError&) {
+    // close() reports this; a destructor cannot.
+  }
+  release();
+}
 
 void BvhStreamWriter::release() noexcept {
   if (fd_ >= 0) ::close(std::exchange(fd_, -1));
+  unnamed_ = false;
 }
 
 void BvhStreamWriter::write_header(double frame_time) {
@@ -136,6 +175,7 @@ void BvhStreamWriter::append(std::span<const float> values) {
   ++frames_;
   write_count();
   end_ += static_cast<std::int64_t>(line_.size());
+  link_unnamed();
 }
 
 // Writes at the end of the counted frames. On failure the file is cut back there, so that it
@@ -181,6 +221,7 @@ void BvhStreamWriter::write_count() {
 
 void BvhStreamWriter::suspend() {
   if (fd_ < 0) return;
+  link_unnamed();  // closing an unnamed file would lose it
   suspended_ = true;
   if (::close(std::exchange(fd_, -1)) != 0)
     throw InputError(path_, error_text("cannot close the BVH file"));
@@ -200,6 +241,7 @@ void BvhStreamWriter::resume() {
 void BvhStreamWriter::close() {
   suspended_ = false;  // a suspended file was closed already, with every frame written
   if (fd_ < 0) return;
+  link_unnamed();
   // Special files (a pipe, /dev/null) cannot be synced; that is no write error.
   const bool synced = ::fdatasync(fd_) == 0 || errno == EINVAL || errno == EROFS;
   const std::string sync_error = synced ? std::string() : error_text("cannot flush the BVH file");

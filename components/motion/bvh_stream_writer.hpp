@@ -2,8 +2,10 @@
 // Writes a BVH file one frame at a time, so that the file on disk is a valid BVH after every
 // frame, also when the process is killed (SIGKILL, a crash) at any moment:
 //
-// - the hierarchy and "Frames: 0000000000" (a fixed-width count) are written first, to PATH.part,
-//   which is then renamed to PATH: the file never exists without its whole header;
+// - the hierarchy and "Frames: 0000000000" (a fixed-width count) are written first, to an unnamed
+//   file linked as PATH with the first frame, or at close() (to PATH.part renamed to PATH at once
+//   when replacing a file, or where the file system has no unnamed files): the file never exists
+//   without its whole header, and a new one not before its first frame unless closed without any;
 // - each frame is one write() of one line, then the count is rewritten in place (pwrite);
 // - a line never crosses a 4 KiB page boundary (spaces at the start of a line pad it to the next
 //   page when it would), and neither does the count, because the kernel can stop a write killed
@@ -28,7 +30,8 @@ class BvhStreamWriter {
   // The most frames a file may hold: the reader's limit.
   static constexpr std::int64_t kMaxFrames = 100'000'000;
 
-  // Creates (or replaces) `path` with the hierarchy and a frame count of 0. Throws
+  // Writes the hierarchy and a frame count of 0 for `path`: a new file appears with its first
+  // frame (or at close() or destruction), an existing one is replaced now. Throws
   // mocap::InputError naming the file when it cannot be created or written.
   BvhStreamWriter(std::string path, Skeleton skeleton, double frame_time);
   BvhStreamWriter(BvhStreamWriter&& other) noexcept;
@@ -58,6 +61,10 @@ class BvhStreamWriter {
 
  private:
   void write_header(double frame_time);
+  // A new file made unnamed with its header (linked as path_ by link_unnamed()); false where
+  // unnamed files are not supported (nothing done then).
+  bool create_unnamed(double frame_time);
+  void link_unnamed();
   void resume();
   void write_at_end(const std::string& bytes);
   void write_count();
@@ -71,7 +78,8 @@ class BvhStreamWriter {
   std::int64_t end_ = 0;           // file size after the last complete frame
   std::int64_t frames_ = 0;
   bool suspended_ = false;
-  std::string line_;  // reused for each frame's text
+  bool unnamed_ = false;  // fd_ is a file without a name yet (no frame written)
+  std::string line_;      // reused for each frame's text
 };
 
 }  // namespace mocap::motion

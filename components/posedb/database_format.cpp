@@ -82,7 +82,9 @@ std::string build_info_to_json(const BuildInfo& b) {
                   {"created", b.created},
                   {"command", b.command},
                   {"build_seconds", b.build_seconds}};
-  return j.dump();
+  // The command and the clips' names and sources hold paths, which may hold any byte: bytes that
+  // are not UTF-8 become U+FFFD rather than failing the build at its end.
+  return j.dump(-1, ' ', false, json::error_handler_t::replace);
 }
 
 BuildInfo build_info_from_json(const std::string& text) {
@@ -121,7 +123,7 @@ std::string clips_to_json(const std::vector<ClipInfo>& clips) {
                    {"metres_per_unit", c.metres_per_unit},
                    {"skeleton", skeleton_to_json(c.skeleton)}});
   }
-  return out.dump();
+  return out.dump(-1, ' ', false, json::error_handler_t::replace);
 }
 
 std::vector<ClipInfo> clips_from_json(const std::string& text) {

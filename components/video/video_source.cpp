@@ -221,6 +221,10 @@ struct VideoSource::Impl {
       fail("cannot open the network stream (unreachable, refused, or not a video; waited " +
            std::to_string(options.timeout_ms) + " ms)");
     fps = capture.get(cv::CAP_PROP_FPS);
+    // A file served over HTTP announces its frames like a file on disk: a stream that stops
+    // before them is cut short (end_of_input). A live stream announces none.
+    const double count = capture.get(cv::CAP_PROP_FRAME_COUNT);
+    frame_count = count > 0 && count < 1e9 ? static_cast<std::int64_t>(count) : -1;
   }
 
   void open_file() {
@@ -314,12 +318,15 @@ struct VideoSource::Impl {
     if (kind == SourceKind::device)
       fail("the camera device stopped delivering frames after " + std::to_string(next_index) +
            " (unplugged?)");
-    if (kind == SourceKind::file && frame_count > 0 &&
+    if ((kind == SourceKind::file || kind == SourceKind::network) && frame_count > 0 &&
         next_index + kFrameCountSlack < frame_count) {
       const std::int64_t missing = frame_count - next_index;
       if (static_cast<double>(missing) > kUndecodableFraction * static_cast<double>(frame_count)) {
-        fail("truncated or damaged: decoding stopped after " + std::to_string(next_index) +
-             " of the " + std::to_string(frame_count) + " frames its container announces");
+        fail(std::string(kind == SourceKind::network ? "the stream stopped early (connection lost "
+                                                       "or the file cut short)"
+                                                     : "truncated or damaged") +
+             ": decoding stopped after " + std::to_string(next_index) + " of the " +
+             std::to_string(frame_count) + " frames its container announces");
       }
       undecodable = missing;
     }

@@ -61,7 +61,8 @@ class VideoSource {
   VideoSource& operator=(VideoSource&&) noexcept;
 
   // The next frame; nullopt at the end of a file, folder or network stream. Throws InputError
-  // when a file ends well before the frames its container announces (truncated), an image
+  // when a file, or a file served over a network stream, ends well before the frames its
+  // container announces (truncated, connection lost), an image
   // of a folder cannot be read, or a camera device stops delivering (unplugged).
   std::optional<Frame> read();
   // Passes over the next frame without converting it (a live file source that fell behind);
@@ -74,7 +75,7 @@ class VideoSource {
   int width() const;
   int height() const;
   double fps() const;                // 0 when the source does not say
-  std::int64_t frame_count() const;  // -1 when unknown (devices, streams)
+  std::int64_t frame_count() const;  // -1 when unknown (devices, live streams)
   std::int64_t frames_read() const;  // returned or skipped so far
   // Frames the file's container announces that could not be decoded (damaged frames FFmpeg
   // passed over), known once read() or skip() has reached the end; 0 before that and for other

@@ -1,34 +1,38 @@
 #include "viz/overlay_output.hpp"
 
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <stdexcept>
 
 #include <opencv2/imgcodecs.hpp>
-#include <opencv2/videoio.hpp>
 
 #include "core/input_error.hpp"
+#include "video/mp4_writer.hpp"
 #include "viz/image_convert.hpp"
 
 namespace mocap::viz {
 
 struct OverlayOutput::Impl {
   OverlayOutputOptions options;
-  cv::VideoWriter video;
-  cv::Size size;
+  std::optional<video::Mp4Writer> video;  // created with the first picture
+  int width = 0, height = 0;
   std::int64_t pictures = 0;
+  std::chrono::steady_clock::time_point last_write{};
+  double rate = 0.0;  // pictures per second, smoothed
   std::int64_t pngs = 0;
 
-  void open_video(cv::Size picture_size) {
-    size = picture_size;
-    if (options.video.empty()) return;
-    if (!video.open(options.video, cv::CAP_FFMPEG, cv::VideoWriter::fourcc('m', 'p', '4', 'v'),
-                    options.fps, size, true)) {
-      throw InputError(options.video, "cannot open the video for writing (MP4, codec mp4v)");
+  // An exponential average of the intervals between pictures: how fast the whole graph runs.
+  void measure_rate() {
+    const auto now = std::chrono::steady_clock::now();
+    if (last_write != std::chrono::steady_clock::time_point{}) {
+      const double seconds = std::chrono::duration<double>(now - last_write).count();
+      if (seconds > 0.0) rate = rate > 0.0 ? 0.9 * rate + 0.1 / seconds : 1.0 / seconds;
     }
+    last_write = now;
   }
-
   void write_png(const cv::Mat& bgr, std::int64_t frame) {
     char name[64];
     std::snprintf(name, sizeof name, "overlay_%06lld.png", static_cast<long long>(frame));
@@ -69,26 +73,30 @@ OverlayOutput& OverlayOutput::operator=(OverlayOutput&&) noexcept = default;
 
 void OverlayOutput::write(const ImageBuffer& picture, std::int64_t frame) {
   Impl& o = *impl_;
-  const cv::Mat bgr = to_bgr(picture);
-  if (o.pictures == 0) o.open_video(bgr.size());
-  if (bgr.size() != o.size) {
+  if (o.pictures == 0) {
+    o.width = picture.width();
+    o.height = picture.height();
+    // The file is made only now: a run that fails before its first picture leaves an existing
+    // video as it was.
+    if (!o.options.video.empty())
+      o.video.emplace(o.options.video, o.width, o.height, video::Mp4WriterOptions{o.options.fps});
+  }
+  if (picture.width() != o.width || picture.height() != o.height) {
     throw std::invalid_argument("overlay output: picture size changed during the run");
   }
-  if (o.video.isOpened()) o.video.write(bgr);
-  if (o.options.png_every > 0 && o.pictures % o.options.png_every == 0) o.write_png(bgr, frame);
+  if (o.video) o.video->write(picture);
+  if (o.options.png_every > 0 && o.pictures % o.options.png_every == 0)
+    o.write_png(to_bgr(picture), frame);
   ++o.pictures;
+  o.measure_rate();
 }
 
 void OverlayOutput::close() {
-  if (!impl_ || !impl_->video.isOpened()) return;
-  impl_->video.release();
-  // VideoWriter reports no write errors; an empty file after frames were written is one.
-  std::error_code ec;
-  if (std::filesystem::file_size(impl_->options.video, ec) == 0 || ec)
-    throw InputError(impl_->options.video, "the video file is empty after writing (disk full?)");
+  if (impl_ && impl_->video) impl_->video->close();
 }
 
 std::int64_t OverlayOutput::pictures() const { return impl_->pictures; }
 std::int64_t OverlayOutput::pngs() const { return impl_->pngs; }
+double OverlayOutput::pictures_per_second() const { return impl_->rate; }
 
 }  // namespace mocap::viz

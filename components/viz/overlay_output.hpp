@@ -1,6 +1,7 @@
 #pragma once
-// Where overlay pictures go: an MP4 video (OpenCV VideoWriter, MPEG-4 Part 2 "mp4v", playable
-// without extra codecs) and/or a PNG snapshot every N pictures.
+// Where overlay pictures go: an MP4 video and/or a PNG snapshot every N pictures. The video is a
+// fragmented MP4 (video::Mp4Writer: H.264, else MPEG-4 Part 2) that plays at every moment: a run
+// killed at any point, SIGKILL included, leaves a file that plays up to about its last frame.
 
 #include <cstdint>
 #include <memory>
@@ -27,13 +28,16 @@ class OverlayOutput {
   OverlayOutput& operator=(OverlayOutput&&) noexcept;
 
   // Writes one picture (every picture of a run has the same size; any pixel format). The video
-  // is opened on the first picture. Throws InputError naming the file when it cannot be written.
+  // file is created on the first picture (nothing is touched before). Throws InputError naming
+  // the file when it cannot be written (disk full, file size limit).
   void write(const ImageBuffer& picture, std::int64_t frame);
-  // Finishes the video file; idempotent.
+  // Finishes the video file; idempotent. Throws InputError naming the file when that fails.
   void close();
 
   std::int64_t pictures() const;  // written so far
   std::int64_t pngs() const;
+  // Pictures written per second of wall-clock time, smoothed (0 before the second one).
+  double pictures_per_second() const;
 
  private:
   struct Impl;

@@ -4,12 +4,10 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
-#include <map>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
-#include <glm/gtx/quaternion.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "viz/image_convert.hpp"
@@ -18,7 +16,7 @@ namespace mocap::viz {
 namespace {
 
 constexpr int kMaxSide = 16384;
-constexpr float kFloorFallback = 0.9f;  // metres below the root when no foot is known
+constexpr int kTitleHeight = 32;  // pixels at the top of the 3D panel kept for its title
 
 cv::Scalar bgr(Rgb c) { return {double(c.b), double(c.g), double(c.r)}; }
 cv::Point pixel(glm::vec2 p) { return {cvRound(p.x), cvRound(p.y)}; }
@@ -129,83 +127,82 @@ void draw_people_2d(const OverlayRenderer& r, cv::Mat& left, const People2D& peo
   }
 }
 
-using Body3D = std::array<glm::vec3, kBodyJoints>;
-
-float floor_height(const std::vector<Body3D>& bodies) {
-  float floor = -std::numeric_limits<float>::infinity();
-  for (const Body3D& b : bodies) {
-    for (Joint foot : {Joint::left_ankle, Joint::right_ankle}) {
-      const float y = b[static_cast<std::size_t>(index(foot))].y;
-      if (std::isfinite(y)) floor = std::max(floor, y);
+// Grid lines on the floor every `step` metres, the step the smallest of 0.5, 1, 2, 5, 10 m that
+// leaves 24 pixels between lines, over the floor the panel shows; fixed to the floor, so the grid
+// moves with the view, not with the people.
+void draw_floor(cv::Mat& right, const SceneCamera& camera) {
+  float step = 10.0f;
+  for (float s : {0.5f, 1.0f, 2.0f, 5.0f}) {
+    if (s * camera.pixels_per_metre() >= 24.0f) {
+      step = s;
+      break;
     }
   }
-  return std::isfinite(floor) ? floor : kFloorFallback;
+  const auto [x0, a0, x1, a1] = camera.visible_floor(step);
+  const cv::Scalar grid(56, 56, 56);
+  auto at = [&](float x, float ahead) { return pixel(camera.project_floor({x, 0.0f, ahead})); };
+  for (float x = x0; x <= x1 + 1e-3f; x += step)
+    cv::line(right, at(x, a0), at(x, a1), grid, 1, cv::LINE_AA);
+  for (float a = a0; a <= a1 + 1e-3f; a += step)
+    cv::line(right, at(x0, a), at(x1, a), grid, 1, cv::LINE_AA);
 }
 
-// Half-metre squares under the people, in the scene's axes (so the floor shows the view's turn),
-// reaching half a metre and more beyond the row of people on every side.
-void draw_floor(const OverlayRenderer& r, cv::Mat& right, float floor_y, int people) {
-  const glm::vec2 panel(float(r.panel_width()), 0.0f);
-  const float row = float(people - 1) / 2.0f * r.person_spacing_m();  // half the row's length
-  const float yaw = glm::radians(r.view_yaw_deg());
-  auto half_metres = [](float metres) { return std::ceil(2.0f * metres + 1.0f) / 2.0f; };
-  const float half_x = half_metres(row * std::abs(std::cos(yaw)) + 0.5f);
-  const float half_z = half_metres(row * std::abs(std::sin(yaw)) + 0.5f);
-  auto at = [&](float x, float z) { return pixel(r.scene_point({x, floor_y, z}, people) - panel); };
-  const cv::Scalar grid(70, 70, 70);
-  for (float x = -half_x; x <= half_x + 1e-3f; x += 0.5f)
-    cv::line(right, at(x, -half_z), at(x, half_z), grid, 1, cv::LINE_AA);
-  for (float z = -half_z; z <= half_z + 1e-3f; z += 0.5f)
-    cv::line(right, at(-half_x, z), at(half_x, z), grid, 1, cv::LINE_AA);
+// The real camera: a dot at its centre over a line down to the floor, when the view shows it.
+void draw_camera(cv::Mat& right, const SceneCamera& camera) {
+  const glm::vec2 centre = camera.project(glm::vec3(0.0f));
+  const glm::vec3 below = camera.floor_coordinates(glm::vec3(0.0f)) * glm::vec3(1, 0, 1);
+  const cv::Rect panel(0, 0, right.cols, right.rows);
+  if (!panel.contains(pixel(centre))) return;
+  cv::line(right, pixel(centre), pixel(camera.project_floor(below)), cv::Scalar(150, 150, 150), 1,
+           cv::LINE_AA);
+  cv::circle(right, pixel(centre), 4, cv::Scalar(230, 230, 230), -1, cv::LINE_AA);
+  put_text(right, "camera", centre + glm::vec2(6, -6), 0.4, {200, 200, 200});
 }
 
-// Slots left to right as the people's boxes stand in the 2D input; people without a box there
-// after them, by id.
-std::vector<const Person3D*> side_by_side_order(const People3D& people, const People2D& people2d) {
-  std::map<int, float> box_centre;
-  for (const Person2D& p : people2d.people) box_centre[p.id] = p.box.x + p.box.width / 2.0f;
-  auto key = [&](const Person3D* p) {
-    const auto it = box_centre.find(p->id);
-    return it == box_centre.end() ? std::make_pair(1, float(p->id)) : std::make_pair(0, it->second);
-  };
-  std::vector<const Person3D*> order;
-  for (const Person3D& p : people.people) order.push_back(&p);
-  std::stable_sort(order.begin(), order.end(),
-                   [&](const Person3D* a, const Person3D* b) { return key(a) < key(b); });
-  return order;
-}
-
-void draw_people_3d(const OverlayRenderer& r, cv::Mat& right, const People3D& people,
-                    const People2D& people2d) {
-  const std::vector<const Person3D*> order = side_by_side_order(people, people2d);
-  std::vector<Body3D> bodies;
-  for (const Person3D* p : order) bodies.push_back(upright_positions(*p));
-  const int count = std::max(1, static_cast<int>(order.size()));
-  draw_floor(r, right, floor_height(bodies), count);
-  const glm::vec2 panel(float(r.panel_width()), 0.0f);
-  for (int slot = 0; slot < static_cast<int>(order.size()); ++slot) {
-    const Body3D& body = bodies[static_cast<std::size_t>(slot)];
-    auto project = [&](glm::vec3 p) { return r.right_point(p, slot, count) - panel; };
-    const int id = order[static_cast<std::size_t>(slot)]->id;
-    draw_skeleton(right, body, project, id_colour(id), 3);
-    const glm::vec3 head = body[static_cast<std::size_t>(index(Joint::head))];
+// The people where they stand (scene_view.hpp), the farthest first so nearer ones cover them.
+void draw_people_3d(cv::Mat& right, SceneCamera& camera, const People3D& people3d,
+                    const People2D& people2d, float spacing_m) {
+  const GroundPlane floor = scene_floor(people3d);
+  std::vector<ScenePerson> people = scene_people(people3d, people2d, floor, spacing_m);
+  camera.follow(floor, people);
+  draw_floor(right, camera);
+  draw_camera(right, camera);
+  const auto root = static_cast<std::size_t>(index(Joint::root));
+  std::stable_sort(people.begin(), people.end(), [&](const ScenePerson& a, const ScenePerson& b) {
+    return camera.depth(a.joints[root]) > camera.depth(b.joints[root]);
+  });
+  const int thickness = std::clamp(static_cast<int>(camera.pixels_per_metre() / 40.0f), 2, 3);
+  auto project = [&](glm::vec3 p) { return camera.project(p); };
+  for (const ScenePerson& p : people) {
+    draw_skeleton(right, p.joints, project, id_colour(p.id), thickness);
+    const glm::vec3 head = p.joints[static_cast<std::size_t>(index(Joint::head))];
     if (finite(head))
-      put_text(right, std::to_string(id), project(head) + glm::vec2(-6, -14), 0.5, id_colour(id));
+      put_text(right, std::to_string(p.id), project(head) + glm::vec2(-6, -12), 0.5,
+               id_colour(p.id));
   }
+}
+
+std::string scene_title(const People3D& people) {
+  std::size_t unplaced = 0;
+  for (const Person3D& p : people.people) unplaced += p.placed ? 0 : 1;
+  if (unplaced == 0) return "3D, second view";
+  return "3D, second view (" + std::to_string(unplaced) + " not placed: in a row)";
+}
+
+// Even sizes: video encoders work on 2x2 blocks.
+int even(double pixels) {
+  return std::clamp(2 * static_cast<int>(std::lround(pixels / 2.0)), 16, kMaxSide);
+}
+
+const OverlayOptions& checked(const OverlayOptions& options) {
+  for (int side : {options.canvas_width, options.canvas_height, options.panel_height}) {
+    if (side < 16 || side > kMaxSide)
+      throw std::invalid_argument("overlay: sizes must be 16 to 16384 pixels");
+  }
+  return options;
 }
 
 }  // namespace
-
-std::array<glm::vec3, kBodyJoints> upright_positions(const Person3D& person) {
-  const glm::vec3 image_up(0.0f, -1.0f, 0.0f);
-  const glm::vec3 body_up = person.root.rotation * glm::vec3(0.0f, 1.0f, 0.0f);
-  std::array<glm::vec3, kBodyJoints> out = person.positions;
-  // No camera looks at the world upside down: such an "up" means the rotation was not set.
-  if (!(glm::dot(body_up, image_up) > 0.0f)) return out;
-  const glm::quat level = glm::rotation(glm::normalize(body_up), image_up);
-  for (glm::vec3& p : out) p = level * p;
-  return out;
-}
 
 Rgb id_colour(int id) {
   if (id < 0) return {200, 200, 200};
@@ -214,14 +211,12 @@ Rgb id_colour(int id) {
   return from_hsv(static_cast<float>(hue), 0.8f, 0.95f);
 }
 
-OverlayRenderer::OverlayRenderer(const OverlayOptions& options) : options_(options) {
-  for (int side : {options.canvas_width, options.canvas_height, options.panel_height}) {
-    if (side < 16 || side > kMaxSide)
-      throw std::invalid_argument("overlay: sizes must be 16 to 16384 pixels");
-  }
-  // Even sizes: video encoders work on 2x2 blocks.
-  const double width = double(options.canvas_width) * options.panel_height / options.canvas_height;
-  panel_width_ = std::clamp(2 * static_cast<int>(std::lround(width / 2.0)), 16, kMaxSide);
+OverlayRenderer::OverlayRenderer(const OverlayOptions& options)
+    : options_(checked(options)),
+      panel_width_(
+          even(double(options.canvas_width) * options.panel_height / options.canvas_height)),
+      camera_(panel_width_, options.panel_height + options.panel_height % 2, kTitleHeight,
+              options.view_yaw_deg, options.view_pitch_deg) {
   options_.panel_height += options_.panel_height % 2;
 }
 
@@ -233,30 +228,12 @@ glm::vec2 OverlayRenderer::left_point(glm::vec2 input, int input_width, int inpu
   return offset + input * scale;
 }
 
-glm::vec2 OverlayRenderer::right_point(glm::vec3 point, int slot, int people) const {
-  // Slots run along the view's horizontal axis on the floor, so the people stand side by side
-  // on the screen, at one height, on the same floor.
-  const float centred = float(slot) - float(people - 1) / 2.0f;
-  const float yaw = glm::radians(options_.view_yaw_deg);
-  const glm::vec3 along_screen(std::cos(yaw), 0.0f, std::sin(yaw));
-  return scene_point(point + centred * options_.person_spacing_m * along_screen, people);
-}
-
-glm::vec2 OverlayRenderer::scene_point(glm::vec3 point, int people) const {
-  // Turn about the vertical, then tilt to look down; orthographic, image y down as the input.
-  const float yaw = glm::radians(options_.view_yaw_deg);
-  const float pitch = glm::radians(options_.view_pitch_deg);
-  const float x = std::cos(yaw) * point.x + std::sin(yaw) * point.z;
-  const float z = -std::sin(yaw) * point.x + std::cos(yaw) * point.z;
-  const float y = std::cos(pitch) * point.y - std::sin(pitch) * z;
-  const float scene_width = std::max(4.0f, float(people) * options_.person_spacing_m + 1.0f);
-  const float scale = std::min(float(panel_width_) / scene_width, float(height()) / 2.4f);
-  return {float(panel_width_) * 1.5f + x * scale, float(height()) * 0.42f + y * scale};
+glm::vec2 OverlayRenderer::scene_pixel(glm::vec3 camera_point) const {
+  return camera_.project(camera_point) + glm::vec2(float(panel_width_), 0.0f);
 }
 
 ImageBuffer OverlayRenderer::render(const People2D& people2d, const People3D& people3d,
-                                    const ImageBuffer& background,
-                                    const OverlayLabel& label) const {
+                                    const ImageBuffer& background, const OverlayLabel& label) {
   ImageBuffer out(width(), height(), PixelFormat::bgr8);
   cv::Mat canvas = as_mat(out);
   canvas.setTo(cv::Scalar(24, 24, 24));
@@ -274,9 +251,9 @@ ImageBuffer OverlayRenderer::render(const People2D& people2d, const People3D& pe
   cv::Mat left = canvas(cv::Rect(0, 0, panel_width_, height()));
   draw_people_2d(*this, left, people2d, input_width, input_height);
   cv::Mat right = canvas(cv::Rect(panel_width_, 0, panel_width_, height()));
-  draw_people_3d(*this, right, people3d, people2d);
+  draw_people_3d(right, camera_, people3d, people2d, options_.person_spacing_m);
   put_text(canvas, frame_text(label), {10, 24}, 0.6, {255, 255, 255});
-  put_text(canvas, "3D, second view", {float(panel_width_) + 10.0f, 24}, 0.6, {255, 255, 255});
+  put_text(canvas, scene_title(people3d), {float(panel_width_) + 10.0f, 24}, 0.6, {255, 255, 255});
   cv::line(canvas, {panel_width_, 0}, {panel_width_, height()}, cv::Scalar(90, 90, 90), 1);
   return out;
 }

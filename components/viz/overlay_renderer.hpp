@@ -1,9 +1,12 @@
 #pragma once
 // The overlay picture: on the left the 2D input (keypoints, bones, box and id of every person, on
-// the video frame or a blank canvas), on the right the reconstructed 3D skeletons seen from a
-// second viewpoint (turned about the vertical and looking down, orthographic) over a floor grid,
-// placed side by side since no root translation is estimated. Each person keeps one colour.
-// Drawn with OpenCV, which stays inside the .cpp files of this library.
+// the video frame or a blank canvas), on the right the reconstructed 3D skeletons in the scene,
+// seen from a second viewpoint (viz/scene_view.hpp): placed where the fitting put them
+// (Person3D::placed, the root translation) on the frame's floor, with a floor grid and the real
+// camera's position; people without a translation stand in a row in front of the camera. A
+// virtual camera (turned about the vertical, looking down, orthographic) frames them all and
+// follows them from frame to frame. Each person keeps one colour. Drawn with OpenCV, which stays
+// inside the .cpp files of this library.
 
 #include <array>
 #include <cstdint>
@@ -13,6 +16,7 @@
 
 #include "core/image_buffer.hpp"
 #include "core/messages.hpp"
+#include "viz/scene_view.hpp"
 
 namespace mocap::viz {
 
@@ -25,19 +29,13 @@ struct Rgb {
 // for untracked people (id < 0).
 Rgb id_colour(int id);
 
-// A person's joints turned so that their body stands up in the picture: a camera looking down
-// (a high database view) sees a standing person tilted; the tilt is removed, the facing kept.
-// The body's up is root.rotation * +Y (root.rotation: body frame, y up, to camera); positions
-// are kept as they are when that rotation was not set (identity: "up" pointing down the image).
-std::array<glm::vec3, kBodyJoints> upright_positions(const Person3D& person);
-
 struct OverlayOptions {
   int canvas_width = 1920;  // the 2D input's pixel space when no video frame is given
   int canvas_height = 1080;
   int panel_height = 480;         // output height; each panel is scaled to it
   float view_yaw_deg = 35.0f;     // 3D panel: camera turned about the vertical from the input's
-  float view_pitch_deg = 20.0f;   // ...and looking down by this much
-  float person_spacing_m = 1.2f;  // 3D panel: distance between people placed side by side
+  float view_pitch_deg = 30.0f;   // ...and looking down by this much
+  float person_spacing_m = 1.2f;  // 3D panel: distance between unplaced people in their row
 };
 
 // Text drawn in the corner.
@@ -58,23 +56,22 @@ class OverlayRenderer {
 
   // Draws one frame, BGR 8-bit. `background` is the video frame the 2D keypoints were found in
   // (any pixel format; its size then defines the 2D pixel space) or empty for a blank canvas.
+  // Frames are drawn in order: the 3D view follows the people from one to the next.
   ImageBuffer render(const People2D& people2d, const People3D& people3d,
-                     const ImageBuffer& background, const OverlayLabel& label) const;
+                     const ImageBuffer& background, const OverlayLabel& label);
 
   // Where a point of the 2D input's pixel space (of size `input_width` x `input_height`) lands
   // in the output: scaled to fit the left panel, centred.
   glm::vec2 left_point(glm::vec2 input, int input_width, int input_height) const;
-  // Where a root-relative 3D point (metres, camera axes) of the person in slot `slot` of
-  // `people` side-by-side slots lands in the output (right panel).
-  glm::vec2 right_point(glm::vec3 point, int slot, int people) const;
-  // The same for a point of the scene the people stand in (slot offsets already applied).
-  glm::vec2 scene_point(glm::vec3 point, int people) const;
-  float person_spacing_m() const { return options_.person_spacing_m; }
-  float view_yaw_deg() const { return options_.view_yaw_deg; }
+  // Where a point of the scene (camera frame, metres; a ScenePerson's joint) landed in the output
+  // (right panel) in the frame drawn last.
+  glm::vec2 scene_pixel(glm::vec3 camera_point) const;
+  const SceneCamera& scene_camera() const { return camera_; }
 
  private:
   OverlayOptions options_;
   int panel_width_ = 0;
+  SceneCamera camera_;
 };
 
 }  // namespace mocap::viz

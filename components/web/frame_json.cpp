@@ -2,7 +2,6 @@
 
 #include <cmath>
 
-#include <glm/geometric.hpp>
 #include <nlohmann/json.hpp>
 
 namespace mocap::web {
@@ -22,17 +21,6 @@ Json rounded(double v, double scale) {
 
 }  // namespace
 
-GroundPlane assumed_ground() { return GroundPlane{{0.0, -1.0, 0.0}, 1.5}; }
-
-glm::vec3 display_root(const GroundPlane& ground, std::size_t slot, std::size_t count) {
-  const float x = (static_cast<float>(slot) - 0.5f * static_cast<float>(count - 1)) * 0.8f;
-  const glm::vec3 ahead(x, 0.0f, 3.0f);
-  const glm::vec3 normal(ground.normal);
-  const glm::vec3 on_floor =
-      ahead - (glm::dot(normal, ahead) + static_cast<float>(ground.offset)) * normal;
-  return on_floor + 0.95f * normal;
-}
-
 std::string hello_json(const std::string& title) {
   Json bones = Json::array();
   for (int j = 0; j < kBodyJoints; ++j) {
@@ -41,7 +29,9 @@ std::string hello_json(const std::string& title) {
   }
   Json names = Json::array();
   for (const auto name : kJointNames) names.push_back(std::string(name));
-  return Json{{"type", "hello"}, {"title", title}, {"joints", names}, {"bones", bones}}.dump();
+  // The title is often a file name, which may hold bytes that are not UTF-8.
+  return Json{{"type", "hello"}, {"title", title}, {"joints", names}, {"bones", bones}}.dump(
+      -1, ' ', false, Json::error_handler_t::replace);
 }
 
 std::string frame_json(const People3D& frame, const std::optional<ShownCamera>& camera,

@@ -7,8 +7,9 @@
 //    "camera":{"known":true,"assumed":false,"width":640,"height":480,"fx":..,"fy":..,"cx":..,"cy":..},
 //    "playback":{"index":5,"count":795,"playing":true,"speed":1,"duration":26.5}}   (recordings)
 // Joints are absolute camera-frame positions (x right, y down, z forward): a placed person's own,
-// an unplaced (root-relative) person's shifted to a display spot (display_root) so that everyone
-// stands on the floor in a row in front of the camera.
+// an unplaced (root-relative) person's shifted to a display spot (core/scene.hpp: display_root,
+// 0.8 m apart) so that everyone stands on the floor in a row in front of the camera; the floor is
+// assumed_ground() when it is not known.
 
 #include <cstddef>
 #include <optional>
@@ -18,6 +19,7 @@
 
 #include "camera/camera.hpp"
 #include "core/messages.hpp"
+#include "core/scene.hpp"
 
 namespace mocap::web {
 
@@ -33,13 +35,6 @@ struct Playback {
   double speed = 1.0;
   double duration = 0.0;  // seconds
 };
-
-// Where the viewer stands the floor when it is not known: level, 1.5 m below the camera.
-GroundPlane assumed_ground();
-
-// Where the root of the `slot`-th of `count` unplaced people is drawn: 3 m in front of the camera,
-// 0.8 m apart left to right, hips 0.95 m above `ground` (the known floor or assumed_ground()).
-glm::vec3 display_root(const GroundPlane& ground, std::size_t slot, std::size_t count);
 
 // The greeting each browser gets first: joint names and the bones (pairs of joint indices).
 std::string hello_json(const std::string& title);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <istream>
 
 #include <nlohmann/json.hpp>
 
@@ -89,6 +90,10 @@ People3D frame_of(const Json& line, std::int64_t number) {
 Recording read_poses_jsonl(const std::string& path, double fps) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path, "cannot open the file");
+  return parse_poses_jsonl(in, path, fps);
+}
+
+Recording parse_poses_jsonl(std::istream& in, const std::string& path, double fps) {
   Recording out;
   bool times_ok = true;
   std::string text;
@@ -103,12 +108,18 @@ Recording read_poses_jsonl(const std::string& path, double fps) {
       if (!has_time || (!out.times.empty() && time < out.times.back())) times_ok = false;
       out.times.push_back(time);
     } catch (const std::exception& e) {
+      if (in.eof() && !out.frames.empty()) {  // no newline after it: cut by a kill
+        out.cut_last_line = true;
+        break;
+      }
       throw InputError(path, line, std::string("not a poses.jsonl line: ") + e.what());
     }
   }
   if (in.bad()) throw InputError(path, "read error");
   if (out.frames.empty()) throw InputError(path, "no frames (an empty poses.jsonl)");
   const double first = out.times.front();
+  // Beyond about 292 years nanoseconds do not fit: such a file plays with its frames `fps` apart.
+  if (times_ok && !(out.times.back() - first < 9.2e9)) times_ok = false;
   for (std::size_t i = 0; i < out.times.size(); ++i) {
     out.times[i] = times_ok ? out.times[i] - first : static_cast<double>(i) / fps;
     out.frames[i].header.capture_ns = static_cast<std::int64_t>(std::llround(out.times[i] * 1e9));

@@ -3,6 +3,7 @@
 // playback clock the page controls (play, pause, seek, speed), looping at the end.
 
 #include <cstddef>
+#include <iosfwd>
 #include <string>
 #include <vector>
 
@@ -12,13 +13,18 @@ namespace mocap::web {
 
 struct Recording {
   std::vector<People3D> frames;
-  std::vector<double> times;  // seconds from the first frame, non-decreasing
+  std::vector<double> times;   // seconds from the first frame, non-decreasing
+  bool cut_last_line = false;  // a last line without its newline that did not parse was skipped
 };
 
 // Reads poses.jsonl. People with `joints_abs` come back placed (root translation set), `ground`
 // sets the floor. Without usable times (missing, or going backwards) frames are `fps` apart.
-// Throws mocap::InputError naming the file and line for anything it cannot read, or an empty file.
+// A last line without its newline that does not parse is what a killed writer leaves (sink.jsonl):
+// it is skipped (cut_last_line). Throws mocap::InputError naming the file and line for anything
+// else it cannot read, or an empty file.
 Recording read_poses_jsonl(const std::string& path, double fps = 30.0);
+// The same from a stream; `name` stands for the file in messages.
+Recording parse_poses_jsonl(std::istream& in, const std::string& name, double fps = 30.0);
 
 class Player {
  public:

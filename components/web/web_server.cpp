@@ -278,6 +278,10 @@ WebServer::WebServer(ServerOptions options) : impl_(std::make_unique<Impl>()) {
     s.shared.greeting = std::make_shared<const std::string>(options.greeting);
   s.shared.options = std::move(options);
   const std::string where = s.host + ":" + std::to_string(s.shared.options.port);
+  // asio keeps the low 16 bits: 99999 would serve on 34463.
+  if (s.shared.options.port < 0 || s.shared.options.port > 65535)
+    throw std::runtime_error("web server: port " + std::to_string(s.shared.options.port) +
+                             " is not a TCP port (1 to 65535, or 0 for a free one)");
   try {
     const tcp::endpoint endpoint = endpoint_of(s.io, s.host, s.shared.options.port);
     s.acceptor.open(endpoint.protocol());

@@ -28,8 +28,10 @@ struct Builder {
     h.regress.assign(2 * kMovenetKeypoints * cells, 0.0f);
     h.offset.assign(2 * kMovenetKeypoints * cells, 0.0f);
   }
+  // NHWC: the channel count is the head's size over the cells.
   static void set(std::vector<float>& head, int c, int y, int x, float v) {
-    head[(static_cast<std::size_t>(c) * kGrid + y) * kGrid + x] = v;
+    const std::size_t channels = head.size() / (kGrid * kGrid);
+    head[(static_cast<std::size_t>(y) * kGrid + x) * channels + c] = v;
   }
   // A person centred on cell (cy, cx) with a box of bh × bw cells and every joint regressed to
   // (cy + dy, cx + dx) where its heatmap peaks.

@@ -130,7 +130,8 @@ TEST(GraphFile, ParameterProblems) {
             std::string::npos)
       << message;
   message = problems("nodes:\n  a: { type: test.counter, params: { count: [1, 2] } }\n");
-  EXPECT_NE(message.find("g.yaml:2: parameter 'count' must be a single value"), std::string::npos)
+  EXPECT_NE(message.find("g.yaml:2: node 'a': parameter 'count' takes a single int, not a list"),
+            std::string::npos)
       << message;
 }
 
@@ -236,18 +237,164 @@ TEST(GraphFile, MissingFile) {
 }
 
 TEST(Params, ParsingAndRanges) {
-  const ParamSpec number{"beta", ParamType::number, 0.4, {0.0, 10.0}, "doc"};
+  const ParamSpec number{
+      .name = "beta", .type = ParamType::number, .fallback = 0.4, .range = {0.0, 10.0}};
   EXPECT_EQ(std::get<double>(parse_param(number, "2.5")), 2.5);
   EXPECT_THROW(parse_param(number, "11"), std::invalid_argument);
   EXPECT_THROW(parse_param(number, "nan"), std::invalid_argument);
   EXPECT_THROW(parse_param(number, "1.0x"), std::invalid_argument);
-  const ParamSpec flag{"on", ParamType::boolean, false, {}, "doc"};
+  const ParamSpec flag{.name = "on", .type = ParamType::boolean, .fallback = false};
   EXPECT_TRUE(std::get<bool>(parse_param(flag, "yes")));
   EXPECT_FALSE(std::get<bool>(parse_param(flag, "False")));
   EXPECT_THROW(parse_param(flag, "maybe"), std::invalid_argument);
   EXPECT_EQ(parse_policy("drop_oldest(4)")->capacity, 4u);
   EXPECT_FALSE(parse_policy("blocking(0)"));
   EXPECT_FALSE(parse_policy("blocking(-1)"));
+}
+
+// A type with a choice, a list, a choice list and a repeated, joined input.
+class Choosy : public Node {
+ public:
+  static void contract(Contract& c) {
+    c.inputs<People2D>("view", "one camera", 2, 4);
+    c.input<People3D>("extra", "not joined", PortFlag::optional);
+    c.output<People2D>("out");
+    c.join({{"view"}, SyncKey::capture_time, 32, 5.0, 100.0});
+    c.param_choice("mode", "live", {"live", "full", "off"}, "how");
+    c.param_list<double>("weights", {1.0, 2.0}, "per view", {0.0, 10.0});
+    c.param_choice_list("joints", {"head"}, {"head", "neck", "root"}, "which");
+  }
+  void process(Context&) override {}
+};
+MOCAP_REGISTER_NODE("unit.choosy", Choosy)
+
+std::string choosy(const std::string& params, const std::string& edges) {
+  return "nodes:\n  a: { type: test.counter }\n  b: { type: test.counter }\n"
+         "  c: { type: test.counter }\n  x: { type: unit.choosy" +
+         (params.empty() ? "" : ", params: " + params) + " }\nedges:\n" + edges;
+}
+const std::string kTwoViews = "  - [a.out, x.view:0]\n  - [b.out, x.view:1]\n";
+
+TEST(GraphFile, RepeatedInputsAreWiredByIndexWithoutGaps) {
+  TempDir dir;
+  testing::write_file(dir.file("g.yaml"),
+                      choosy("", "  - [b.out, x.view:1]\n  - [a.out, x.view:0]\n"));
+  const ResolvedGraph graph = resolve(load_graph_file(dir.file("g.yaml")));
+  EXPECT_EQ(graph.find("x")->input_counts, (std::vector<std::size_t>{2, 0}));
+  EXPECT_NE(to_dot(graph).find("out -> view:1"), std::string::npos) << to_dot(graph);
+
+  std::string message = problems(choosy("", "  - [a.out, x.view:0]\n  - [b.out, x.view:2]\n"));
+  EXPECT_NE(message.find("g.yaml:8: input x.view:1 is not connected, but x.view:2 is"),
+            std::string::npos)
+      << message;
+  message = problems(choosy("", "  - [a.out, x.view]\n  - [b.out, x.view:1]\n"));
+  EXPECT_NE(message.find("g.yaml:7: edge a.out -> x.view: x.view is a repeated input: wire each "
+                         "edge to an index, x.view:0"),
+            std::string::npos)
+      << message;
+  message = problems(choosy("", "  - [a.out, x.view:0]\n"));
+  EXPECT_NE(message.find("g.yaml:7: input x.view takes 2 to 4 edges (x.view:0..3), not 1"),
+            std::string::npos)
+      << message;
+  message = problems(choosy("", kTwoViews + "  - [c.out, x.view:1]\n"));
+  EXPECT_NE(message.find("g.yaml:9: input x.view:1 is already fed by the edge at g.yaml:8"),
+            std::string::npos)
+      << message;
+  message = problems(
+      "nodes:\n  a: { type: test.counter }\n  p: { type: flow.pass_through }\n"
+      "edges:\n  - [a.out, p.in:0]\n");
+  EXPECT_NE(message.find("g.yaml:5: edge a.out -> p.in:0: input p.in takes one edge, without an "
+                         "index"),
+            std::string::npos)
+      << message;
+  message = problems(
+      "nodes:\n  a: { type: test.counter }\n  p: { type: flow.pass_through }\n"
+      "edges:\n  - [a.out:1, p.in]\n");
+  EXPECT_NE(message.find("g.yaml:5: edge a.out:1 -> p.in: an output takes no index"),
+            std::string::npos)
+      << message;
+  message = problems("nodes:\n  a: { type: test.counter }\nedges:\n  - [a.out, b.in:x]\n");
+  EXPECT_NE(message.find("g.yaml:4: edge end 'b.in:x' must be written node.port"),
+            std::string::npos)
+      << message;
+}
+
+TEST(GraphFile, ChoicesAreCheckedWithTheAllowedValuesAndANearMiss) {
+  EXPECT_EQ(problems(choosy("{ mode: full }", kTwoViews)), "");
+  std::string message = problems(choosy("{ mode: fulll }", kTwoViews));
+  EXPECT_NE(message.find("g.yaml:5: node 'x': parameter 'mode': 'fulll' is not one of live, full, "
+                         "off; did you mean 'full'?"),
+            std::string::npos)
+      << message;
+  message = problems(choosy("{ mode: sideways }", kTwoViews));
+  EXPECT_NE(message.find("'sideways' is not one of live, full, off"), std::string::npos) << message;
+  EXPECT_EQ(message.find("did you mean"), std::string::npos) << message;
+  message = problems(choosy("", kTwoViews), {"x.mode=Live"});
+  EXPECT_NE(message.find("--set x.mode=Live: node 'x': parameter 'mode': 'Live' is not one of "
+                         "live, full, off; did you mean 'live'?"),
+            std::string::npos)
+      << message;
+  // The synchroniser's parameters are checked the same way.
+  message = problems(choosy("{ sync_by: frames }", kTwoViews));
+  EXPECT_NE(message.find("did you mean 'frame'?"), std::string::npos) << message;
+  // Names too: an unknown parameter or type close to a known one.
+  message = problems(choosy("{ mdoe: full }", kTwoViews));
+  EXPECT_NE(message.find("has no parameter 'mdoe'; did you mean 'mode'?"), std::string::npos)
+      << message;
+  message = problems("nodes:\n  a: { type: test.countr }\n");
+  EXPECT_NE(message.find("unknown node type 'test.countr' (did you mean 'test.counter'?"),
+            std::string::npos)
+      << message;
+}
+
+TEST(GraphFile, ListsAreYamlSequencesOrCommaListsWithEachItemChecked) {
+  TempDir dir;
+  testing::write_file(dir.file("g.yaml"),
+                      choosy("{ weights: [0.5, 3], joints: [neck, root] }", kTwoViews));
+  GraphSpec spec = load_graph_file(dir.file("g.yaml"));
+  ResolvedGraph graph = resolve(spec);
+  EXPECT_EQ(std::get<std::vector<double>>(graph.find("x")->params.at("weights")),
+            (std::vector<double>{0.5, 3.0}));
+  EXPECT_EQ(std::get<std::vector<std::string>>(graph.find("x")->params.at("joints")),
+            (std::vector<std::string>{"neck", "root"}));
+  apply_overrides(spec, {"x.weights=1, 2,4", "x.joints="});
+  graph = resolve(spec);
+  EXPECT_EQ(std::get<std::vector<double>>(graph.find("x")->params.at("weights")),
+            (std::vector<double>{1.0, 2.0, 4.0}));
+  EXPECT_TRUE(std::get<std::vector<std::string>>(graph.find("x")->params.at("joints")).empty());
+
+  std::string message = problems(choosy("{ weights: [1, 20] }", kTwoViews));
+  EXPECT_NE(message.find("g.yaml:5: node 'x': parameter 'weights': expected a value in [0"),
+            std::string::npos)
+      << message;
+  message = problems(choosy("{ joints: [head, nek] }", kTwoViews));
+  EXPECT_NE(message.find("'nek' is not one of head, neck, root; did you mean 'neck'?"),
+            std::string::npos)
+      << message;
+  message = problems(choosy("{ mode: [live, off] }", kTwoViews));
+  EXPECT_NE(
+      message.find("g.yaml:5: node 'x': parameter 'mode' takes a single choice of live, full, "
+                   "off, not a list"),
+      std::string::npos)
+      << message;
+  message = problems(choosy("{ weights: [1, [2]] }", kTwoViews));
+  EXPECT_NE(message.find("g.yaml:5:"), std::string::npos) << message;
+}
+
+TEST(Registry, InspectShowsRepeatedInputsJoinsChoicesAndLists) {
+  const std::string text = describe(*Registry::instance().find("unit.choosy"));
+  EXPECT_NE(text.find("view:0..N : People2D (2 to 4 edges) (joined)"), std::string::npos) << text;
+  EXPECT_NE(text.find("joined: view, one set per capture time"), std::string::npos) << text;
+  EXPECT_NE(text.find("mode : choice of live, full, off = live"), std::string::npos) << text;
+  EXPECT_NE(text.find("weights : list of number = 1,2 in [0"), std::string::npos) << text;
+  EXPECT_NE(text.find("sync_tolerance_ms : number = 5"), std::string::npos) << text;
+  EXPECT_NE(text.find("sync_by : choice of frame, capture_time = capture_time"), std::string::npos)
+      << text;
+  Contract c;
+  c.input_any("a");
+  EXPECT_THROW(c.join({{"b"}}), std::logic_error);
+  EXPECT_THROW(c.param_choice("m", "x", {"a", "b"}, "a default outside its choices"),
+               std::invalid_argument);
 }
 
 TEST(Registry, ContractsAndInspect) {

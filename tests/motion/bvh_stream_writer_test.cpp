@@ -78,8 +78,13 @@ void expect_frames(const Clip& clip, const Skeleton& s, int frames) {
 TEST(BvhStreamWriter, FileReadsBackExactlyAfterEveryFrame) {
   test::TempDir dir;
   const Skeleton s = chain(5);
+  {
+    BvhStreamWriter empty(dir.file("empty.bvh"), s, 1.0 / 30.0);
+    EXPECT_FALSE(std::filesystem::exists(dir.file("empty.bvh"))) << "a new file before a frame";
+    empty.close();  // closed without a frame: the hierarchy and a count of 0
+    EXPECT_EQ(read_bvh(dir.file("empty.bvh")).frame_count, 0);
+  }
   BvhStreamWriter writer(dir.file("a.bvh"), s, 1.0 / 30.0);
-  EXPECT_EQ(read_bvh(dir.file("a.bvh")).frame_count, 0);
   for (int f = 0; f < 40; ++f) {
     writer.append(frame_values(s, f));
     const Clip clip = read_bvh(dir.file("a.bvh"));
@@ -96,8 +101,9 @@ TEST(BvhStreamWriter, FileReadsBackExactlyAfterEveryFrame) {
 TEST(BvhStreamWriter, EveryStateAKillCanLeaveReadsBack) {
   test::TempDir dir;
   const Skeleton s = chain(4);
+  BvhStreamWriter(dir.file("header.bvh"), s, 0.04).close();  // what b.bvh holds before a frame
   BvhStreamWriter writer(dir.file("b.bvh"), s, 0.04);
-  std::vector<std::string> states{read_bytes(dir.file("b.bvh"))};
+  std::vector<std::string> states{read_bytes(dir.file("header.bvh"))};
   for (int f = 0; f < 12; ++f) {
     writer.append(frame_values(s, f));
     states.push_back(read_bytes(dir.file("b.bvh")));
@@ -178,6 +184,37 @@ TEST(BvhStreamWriter, FileOfAProcessKilledMidWriteReadsBack) {
               << " frames\n";
     if (round > 4) {
       EXPECT_GT(clip.frame_count, 0) << "round " << round;
+    }
+  }
+}
+
+// A process making many new files, killed while at it, leaves each of them whole or absent and no
+// temporary file beside them (a new file is written unnamed and linked with its header).
+TEST(BvhStreamWriter, AKillWhileCreatingFilesLeavesNoTemporaryFile) {
+  test::TempDir dir;
+  const Skeleton s = chain(31);
+  for (int round = 0; round < 4; ++round) {
+    const std::filesystem::path folder = dir.path() / std::to_string(round);
+    std::filesystem::create_directories(folder);
+    const pid_t child = fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {
+      try {
+        for (int k = 0; k < 100'000; ++k)  // bounded: it can never run away
+          BvhStreamWriter((folder / ("p" + std::to_string(k) + ".bvh")).string(), s, 0.01);
+      } catch (...) {
+        _exit(3);
+      }
+      _exit(2);
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20 + 13 * round));
+    ASSERT_EQ(kill(child, SIGKILL), 0);
+    int status = 0;
+    ASSERT_EQ(waitpid(child, &status, 0), child);
+    ASSERT_TRUE(WIFSIGNALED(status)) << "the child ended by itself, status " << status;
+    for (const auto& e : std::filesystem::directory_iterator(folder)) {
+      EXPECT_EQ(e.path().extension(), ".bvh") << e.path();
+      EXPECT_EQ(read_bvh(e.path().string()).frame_count, 0) << e.path();
     }
   }
 }

@@ -1,9 +1,12 @@
 // recon.fit in a graph: people placed at the depth their clean projection shows, with constant
 // bones, live and full; a person missing from a frame does not break the window; every frame out;
-// joints_abs in poses.jsonl; a fit without a camera is refused by name.
+// joints_abs in poses.jsonl; full mode's frames reach the sink while the stream goes on, and a
+// stop keeps every frame the node took in; a fit without a camera is refused by name.
 
+#include <chrono>
 #include <cmath>
 #include <map>
+#include <thread>
 
 #include <nlohmann/json.hpp>
 
@@ -18,13 +21,19 @@ using testing::run_graph;
 using testing::stats_of;
 
 constexpr double kHfovDeg = 56.14497;  // fx = 600 on 640 pixels: the script source's camera
+// How soon after a stop request the graph must have ended: 2 s; a sanitizer build is slower.
+#if defined(__SANITIZE_ADDRESS__)
+constexpr double kStopBoundS = 6.0;
+#else
+constexpr double kStopBoundS = 2.0;
+#endif
 
 std::string fit_graph(const std::string& db, const std::string& script, const std::string& jsonl,
-                      const std::string& fit_params) {
+                      const std::string& fit_params, const std::string& source_params = "") {
   return R"(
 nodes:
   src: { type: unit.people_script, params: { db: )" +
-         db + ", script: \"" + script + R"(", depth_m: 4.0 } }
+         db + ", script: \"" + script + R"(", depth_m: 4.0)" + source_params + R"( } }
   fit: { type: recon.fit, params: { db: )" +
          db + ", " + fit_params + R"( } }
   out: { type: sink.jsonl, params: { path: )" +
@@ -139,6 +148,40 @@ TEST(FitNode, FullSequencePlacesPeopleAtTheirDepthWithConstantBones) {
                     std::to_string(kHfovDeg)));
   ASSERT_TRUE(result.ok) << result.error;
   expect_placed_at_their_depth(read_placed(jsonl));
+}
+
+TEST(FitNode, FullModeFramesReachTheSinkWhileTheStreamGoesOnAndAStopKeepsThemAll) {
+  MOCAP_REQUIRE_SMALL_DATABASE(db);
+  test::TempDir dir;
+  const std::string jsonl = dir.file("poses.jsonl");
+  // The script again and again until the stop: the stream has no end of its own.
+  graph::Runtime runtime(graph::resolve(graph::parse_graph_text(
+      fit_graph(db, walking_script(), jsonl,
+                "mode: full, window: 16, overlap: 4, contact: false, ground: off, image_width: "
+                "640, image_height: 480, hfov_deg: " +
+                    std::to_string(kHfovDeg),
+                ", repeat: true, interval_ms: 2"),
+      "test.yaml")));
+  graph::RunResult result;
+  std::thread run([&] { result = runtime.run(); });
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (test::read_lines(jsonl).size() < 40 && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  const std::size_t seen = test::read_lines(jsonl).size();
+  const auto stop = std::chrono::steady_clock::now();
+  runtime.request_stop();
+  run.join();
+  const double stop_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - stop).count();
+  EXPECT_GE(seen, 40u) << "full mode sent nothing while the stream went on";
+  ASSERT_TRUE(result.ok) << result.error;
+  EXPECT_LT(stop_s, kStopBoundS);
+  // Every frame the fit took in went out, and reached the file as a whole line.
+  const auto& fit = stats_of(result, "fit");
+  EXPECT_EQ(fit.out, fit.in);
+  const auto lines = test::read_lines(jsonl);
+  EXPECT_EQ(lines.size(), fit.out);
+  for (const auto& line : lines) EXPECT_TRUE(nlohmann::json::accept(line)) << line;
 }
 
 TEST(FitNode, WithoutACameraTheGraphIsRefusedNamingWhatIsMissing) {

@@ -71,7 +71,7 @@ class PeopleScriptSource : public Node {
     c.output<VideoFrame>("video");
     c.required_param<std::string>("db", "pose database");
     c.required_param<std::string>("script", "frames ';', people ',', person id:clip:offset:view");
-    c.param<std::string>("skip_2d", "", "frames (comma-separated) sent without People2D");
+    c.param_list<std::int64_t>("skip_2d", {}, "frames sent without People2D", {0, 1e9});
     c.param<bool>("repeat", false, "play the script until stopped");
     c.param<double>("interval_ms", 0.0, "pause between frames", {0, 10000});
     c.param<double>("depth_m", 0.0, "place people in front of a pinhole camera (0: no keypoints)",
@@ -81,10 +81,7 @@ class PeopleScriptSource : public Node {
   void open(Context& ctx) override {
     db_ = std::make_unique<posedb::Database>(posedb::Database::open(ctx.param<std::string>("db")));
     script_ = parse_script(ctx.param<std::string>("script"));
-    std::istringstream skip(ctx.param<std::string>("skip_2d"));
-    for (std::string f; std::getline(skip, f, ',');) {
-      if (!f.empty()) skip_2d_.push_back(std::stoll(f));
-    }
+    skip_2d_ = ctx.param<std::vector<std::int64_t>>("skip_2d");
     repeat_ = ctx.param<bool>("repeat");
     depth_m_ = ctx.param<float>("depth_m");
     interval_ =

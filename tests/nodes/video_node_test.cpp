@@ -1,7 +1,7 @@
 // source.video in a graph: offline it sends every frame stamped with its time in the video;
 // live it replays a file at the file's rate with wall-clock capture times and skips frames a
-// slow consumer made late (counted); a truncated video and an absent camera stop the graph with
-// an error naming the node and the input.
+// slow consumer made late (counted); a truncated video, a stream that stops before the frames it
+// announced and an absent camera stop the graph with an error naming the node and the input.
 
 #include <gtest/gtest.h>
 
@@ -10,10 +10,13 @@
 #include <mutex>
 #include <vector>
 
+#include "core/input_error.hpp"
+#include "graph/harness.hpp"
 #include "graph/registry.hpp"
 #include "graph/transport.hpp"
 #include "sink_test_util.hpp"
 #include "support/files.hpp"
+#include "support/http_file_server.hpp"
 
 namespace mocap::nodes {
 namespace {
@@ -62,21 +65,37 @@ std::string graph_yaml(const std::string& source_params, const std::string& edge
          std::to_string(delay_ms) + " } }\nedges:\n  - [src.frames, out.in" + edge + "]\n";
 }
 
+// Alone in the test harness (graph/harness.hpp): run the source a few calls at a time and pull
+// what it sent, so only a few decoded frames are held at once.
 TEST(VideoSourceNode, OfflineSendsEveryFrameStampedWithItsTimeInTheVideo) {
   if (!fs::exists(kVtestPart)) GTEST_SKIP() << "shared video absent: " << kVtestPart;
-  seen.clear();
-  const RunResult result =
-      testing::run_graph(graph_yaml("path: " + kVtestPart + ", mode: offline"));
-  ASSERT_TRUE(result.ok) << result.error;
-  ASSERT_EQ(seen.size(), 200u);
-  for (std::size_t i = 0; i < seen.size(); ++i) {
-    EXPECT_EQ(seen[i].header.seq, i);
-    EXPECT_EQ(seen[i].header.frame, static_cast<std::int64_t>(i));
-    EXPECT_NEAR(static_cast<double>(seen[i].header.capture_ns) * 1e-9, 0.1 * i, 0.011);
-    EXPECT_EQ(seen[i].width, 768);
-    EXPECT_EQ(seen[i].height, 576);
+  Harness src("source.video", {{"path", kVtestPart}, {"mode", "offline"}});
+  std::size_t count = 0;
+  while (!src.ended("frames") && count < 1000) {
+    src.run_source(20);
+    for (const auto& frame : src.pull<VideoFrame>("frames")) {
+      EXPECT_EQ(frame->header.seq, count);
+      EXPECT_EQ(frame->header.frame, static_cast<std::int64_t>(count));
+      EXPECT_NEAR(static_cast<double>(frame->header.capture_ns) * 1e-9, 0.1 * count, 0.011);
+      EXPECT_EQ(frame->image.width(), 768);
+      EXPECT_EQ(frame->image.height(), 576);
+      ++count;
+    }
   }
-  EXPECT_EQ(testing::stats_of(result, "src").drops, 0u);
+  EXPECT_EQ(count, 200u);
+  EXPECT_EQ(src.stats().drops, 0u);
+}
+
+TEST(VideoSourceNode, AModeThatIsNoChoiceIsRefusedBeforeOpening) {
+  try {
+    Harness src("source.video", {{"path", kVtestPart}, {"mode", "Live"}});
+    FAIL() << "mode Live was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("'Live' is not one of offline, live, auto; did you "
+                                         "mean 'live'?"),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 TEST(VideoSourceNode, LiveReplaysAFileAtItsRateWithWallClockCaptureTimes) {
@@ -141,6 +160,33 @@ TEST(VideoSourceNode, ATruncatedVideoStopsTheGraphNamingTheNodeAndTheFile) {
   EXPECT_GT(seen.size(), 10u);  // the frames before the cut went through
 }
 
+// The clip served over HTTP: whole, every frame arrives and the stream ends; cut after half its
+// bytes (the connection lost), the graph stops with an error naming the stream, after the frames
+// that arrived, as it does for a truncated file.
+TEST(VideoSourceNode, AStreamThatStopsMidFileStopsTheGraphLikeATruncatedFile) {
+  if (!fs::exists(kVtestPart)) GTEST_SKIP() << "shared video absent: " << kVtestPart;
+  const std::string bytes = test::read_file(kVtestPart);
+  {
+    const test::HttpFileServer whole(bytes);
+    seen.clear();
+    const RunResult result = testing::run_graph(
+        graph_yaml("path: '" + whole.url("vtest.avi") + "', mode: offline, timeout_ms: 5000"));
+    ASSERT_TRUE(result.ok) << result.error;
+    EXPECT_EQ(seen.size(), 200u);
+  }
+  const test::HttpFileServer cut(bytes, bytes.size() / 2);
+  const std::string url = cut.url("vtest.avi");
+  seen.clear();
+  const RunResult result =
+      testing::run_graph(graph_yaml("path: '" + url + "', mode: offline, timeout_ms: 5000"));
+  ASSERT_FALSE(result.ok) << seen.size() << " frames and no error";
+  EXPECT_NE(result.error.find("'src'"), std::string::npos) << result.error;
+  EXPECT_NE(result.error.find(url), std::string::npos) << result.error;
+  EXPECT_NE(result.error.find("stopped early"), std::string::npos) << result.error;
+  EXPECT_GT(seen.size(), 10u);  // the frames before the cut went through
+  EXPECT_LT(seen.size(), 200u);
+}
+
 // A copy of the clip with 20000 random bytes at a quarter, half and three quarters of it: FFmpeg
 // passes over the frames it
 // cannot decode; the run goes on to the end and counts them (drops, status line).
@@ -195,11 +241,17 @@ TEST(VideoSourceNode, AnAbsentCameraStopsTheGraphWithAClearError) {
   EXPECT_NE(result.error.find("no such camera device"), std::string::npos) << result.error;
 }
 
-TEST(VideoSourceNode, RefusesAnUnknownMode) {
-  if (!fs::exists(kVtestPart)) GTEST_SKIP() << "shared video absent: " << kVtestPart;
-  const RunResult result = testing::run_graph(graph_yaml("path: " + kVtestPart + ", mode: fast"));
-  ASSERT_FALSE(result.ok);
-  EXPECT_NE(result.error.find("offline, live or auto"), std::string::npos) << result.error;
+// A mode is a choice: graph validation refuses an unknown one, before any node runs.
+TEST(VideoSourceNode, RefusesAnUnknownModeWhenTheGraphIsValidated) {
+  try {
+    testing::run_graph(graph_yaml("path: " + kVtestPart + ", mode: fast"));
+    FAIL() << "mode fast was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("test.yaml:2: node 'src': parameter 'mode': 'fast' is "
+                                         "not one of offline, live, auto"),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 }  // namespace

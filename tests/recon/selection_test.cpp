@@ -7,6 +7,7 @@
 
 #include "posedb/builder.hpp"
 #include "posedb/projection.hpp"
+#include "recon/people_selector.hpp"
 #include "recon/sequence_reconstruction.hpp"
 #include "support/shared_data.hpp"
 
@@ -154,6 +155,45 @@ TEST_F(SelectionTest, LaggedPathDecidesEveryFrameOnceInOrder) {
   for (const auto& [frame, choice] : lagged.flush()) decided.push_back(frame);
   ASSERT_EQ(decided.size(), input.size());
   for (std::size_t t = 0; t < decided.size(); ++t) EXPECT_EQ(decided[t], t);
+}
+
+TEST_F(SelectionTest, PeopleSelectorGivesOneFrameOutPerFrameInOrderAfterTheLag) {
+  // Person 1 in every frame, person 2 missing in frames 10-12, untracked people (id -1) ignored.
+  const auto walk = replay(1, 0, 40, 3), other = replay(2, 100, 40, 5);
+  Matcher matcher(*db_, MatchOptions{});
+  PeopleSelectorOptions options;
+  options.mode = SelectionMode::path;
+  options.lag = 5;
+  PeopleSelector selector(*db_, *bones_, options);
+  std::vector<People3D> out;
+  for (std::size_t t = 0; t < walk.size(); ++t) {
+    PoseMatches in;
+    in.header.seq = t;
+    for (const auto& [id, input] :
+         {std::pair{2, &other}, std::pair{1, &walk}, std::pair{-1, &walk}}) {
+      if (id == 2 && t >= 10 && t <= 12) continue;
+      PersonMatch person;
+      person.id = id;
+      for (int j = 0; j < kBodyJoints; ++j)
+        person.body[j] = {(*input)[t][3 * j], (*input)[t][3 * j + 1], (*input)[t][3 * j + 2]};
+      matcher.match((*input)[t], person.candidates);
+      in.people.push_back(person);
+    }
+    for (auto& f : selector.push(in)) out.push_back(std::move(f));
+    EXPECT_EQ(out.size(), t >= 5 ? t - 4 : 0) << "frame " << t;  // decided 5 frames late
+  }
+  for (auto& f : selector.finish()) out.push_back(std::move(f));
+  ASSERT_EQ(out.size(), walk.size());
+  for (std::size_t t = 0; t < out.size(); ++t) {
+    EXPECT_EQ(out[t].header.seq, t);
+    const std::size_t people = t >= 10 && t <= 12 ? 1 : 2;
+    ASSERT_EQ(out[t].people.size(), people) << "frame " << t;
+    EXPECT_EQ(out[t].people[0].id, 1);  // sorted by id
+    EXPECT_EQ(out[t].people[0].keypoints[index(Joint::neck)].x, walk[t][3 * index(Joint::neck)]);
+    if (people == 2) {
+      EXPECT_EQ(out[t].people[1].id, 2);
+    }
+  }
 }
 
 }  // namespace

@@ -1,7 +1,7 @@
 // `mocap reconstruct VIDEO` end to end, through the built binary: the first frames of the shared
 // vtest video become poses.jsonl (one line per frame, its time in the video), BVH files, an
-// overlay video and a summary; a missing model, a truncated or unreadable video and an absent
-// camera each end the run with exit code 1 and a message naming the problem.
+// overlay video (a picture per frame) and a summary; a missing model, a truncated or unreadable
+// video and an absent camera each end the run with exit code 1 and a message naming the problem.
 
 #include <gtest/gtest.h>
 
@@ -10,6 +10,7 @@
 #include "detect/model_files.hpp"
 #include "support/mocap_process.hpp"
 #include "support/shared_data.hpp"
+#include "video/video_source.hpp"
 
 namespace mocap {
 namespace {
@@ -58,7 +59,8 @@ bool model_present() {
 TEST_F(ReconstructVideoTest, AVideoBecomesPosesBvhAndAnOverlayVideo) {
   if (!model_present()) GTEST_SKIP() << "MoveNet model absent: tools/setup.sh --models-only";
   auto run =
-      reconstruct("out", kVideo.string(), {"--detector-size", "384", "--set", "src.count=30"});
+      reconstruct("out", kVideo.string(),
+                  {"--detector", "multipose", "--detector-size", "384", "--set", "src.count=30"});
   ASSERT_EQ(run.wait(300s), 0) << run.err();
   const std::string out = dir_->file("out");
   const auto lines = test::read_lines(out + "/poses.jsonl");
@@ -88,14 +90,22 @@ TEST_F(ReconstructVideoTest, AVideoBecomesPosesBvhAndAnOverlayVideo) {
   EXPECT_GT(people, 30u);              // pedestrians are found: more than one per frame on average
   EXPECT_GE(placed, people * 9 / 10);  // the fit (full, by default for a file) placed them
   EXPECT_GT(grounded, 0u);
-  EXPECT_GT(fs::file_size(out + "/overlay.mp4"), 10000u);
+  // The overlay has a picture per frame, each drawn over its video frame read again from the file
+  // (sink.overlay's video_path, set by reconstruct for files).
+  video::VideoSource overlay(out + "/overlay.mp4");
+  int pictures = 0;
+  while (overlay.read()) ++pictures;
+  EXPECT_EQ(pictures, 30);
+  EXPECT_EQ(overlay.width(), 1280);  // two 640 x 480 panels for the 768 x 576 video
+  EXPECT_NE(run.err().find("30 video frames read again"), std::string::npos) << run.err();
   bool bvh = false;
   for (const auto& e : fs::directory_iterator(out)) bvh = bvh || e.path().extension() == ".bvh";
   EXPECT_TRUE(bvh);
   const auto summary = nlohmann::json::parse(test::read_file(out + "/summary.json"));
   EXPECT_EQ(summary.at("video").at("width"), 768);
   EXPECT_EQ(summary.at("video").at("height"), 576);
-  EXPECT_EQ(summary.at("detector_size"), 384);
+  EXPECT_EQ(summary.at("detector").at("type"), "detect.movenet");
+  EXPECT_EQ(summary.at("detector").at("params").at("input_size"), "384");
   EXPECT_EQ(summary.at("frames"), 30);
   EXPECT_EQ(summary.at("fit"), "full");
   EXPECT_NE(run.out().find(out + "/overlay.mp4"), std::string::npos) << run.out();

@@ -1,11 +1,14 @@
 // The overlay renderer draws each person in their colour where they belong (2D on the left, 3D on
-// the right), and the input joiner pairs messages by frame and counts what it must drop.
+// the right: placed where the fitting put them, or in a row), the 3D view frames and follows them.
+// Joining its inputs by frame is the framework's (tests/graph/synchronizer_test.cpp).
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-#include "viz/overlay_inputs.hpp"
+#include <glm/gtx/quaternion.hpp>
+
+#include "core/scene.hpp"
 #include "viz/overlay_renderer.hpp"
 
 namespace mocap::viz {
@@ -101,8 +104,8 @@ TEST(IdColour, StableDistinctAndGreyWhenUntracked) {
   EXPECT_EQ(id_colour(-1), (Rgb{200, 200, 200}));
 }
 
-TEST(OverlayRenderer, TwoPeopleDrawnInTheirColoursOnBothPanels) {
-  const OverlayRenderer renderer(OverlayOptions{1280, 720});
+TEST(OverlayRenderer, TwoUnplacedPeopleDrawnInTheirColoursOnBothPanelsInARow) {
+  OverlayRenderer renderer(OverlayOptions{1280, 720});
   ASSERT_EQ(renderer.height(), 480);
   ASSERT_EQ(renderer.width(), 2 * 854);  // 1280 x 720 scaled to 480 high, even width
   People2D people2d;
@@ -131,12 +134,23 @@ TEST(OverlayRenderer, TwoPeopleDrawnInTheirColoursOnBothPanels) {
   EXPECT_GT(pixels_of(image, two, 0, half / 2), 50);
   EXPECT_EQ(pixels_of(image, two, 2 * half / 3, half), 0);
   EXPECT_GT(pixels_of(image, seven, half / 2, half), 50);
-  // Right panel: person 2 in slot 0 (left), person 7 in slot 1, along the spine.
-  for (auto [colour, slot] : {std::pair{two, 0}, std::pair{seven, 1}}) {
-    const glm::vec2 spine = renderer.right_point({0.0f, -0.25f, 0.0f}, slot, 2);
+  // Right panel: in a row in front of the camera, person 2 on the left (slot 0), 7 on the right,
+  // 1.2 m apart; along the spine.
+  const auto scene = scene_people(people3d, people2d, scene_floor(people3d), 1.2f);
+  ASSERT_EQ(scene.size(), 2u);
+  EXPECT_EQ(scene[1].id, 2);
+  EXPECT_FALSE(scene[1].placed);
+  const auto root = static_cast<std::size_t>(index(Joint::root));
+  const auto neck = static_cast<std::size_t>(index(Joint::neck));
+  EXPECT_NEAR(scene[0].joints[root].x - scene[1].joints[root].x, 1.2f, 1e-4f);
+  EXPECT_NEAR(scene[0].joints[root].z, 3.0f, 1e-4f);  // display_root: 3 m ahead
+  for (const ScenePerson& p : scene) {
+    const glm::vec2 spine = renderer.scene_pixel((p.joints[root] + p.joints[neck]) / 2.0f);
     EXPECT_GE(spine.x, half);
-    EXPECT_TRUE(colour_near(image, spine, colour)) << "3D slot " << slot;
+    EXPECT_TRUE(colour_near(image, spine, id_colour(p.id))) << "3D person " << p.id;
   }
+  EXPECT_LT(renderer.scene_pixel(scene[1].joints[root]).x,
+            renderer.scene_pixel(scene[0].joints[root]).x);
   EXPECT_GT(pixels_of(image, two, half, 2 * half), 50);
   EXPECT_GT(pixels_of(image, seven, half, 2 * half), 50);
 }
@@ -144,7 +158,7 @@ TEST(OverlayRenderer, TwoPeopleDrawnInTheirColoursOnBothPanels) {
 TEST(OverlayRenderer, VideoFrameIsTheLeftBackgroundInAnyPixelFormat) {
   OverlayOptions options;
   options.canvas_width = 640;  // ignored: the video frame's size decides
-  const OverlayRenderer renderer(options);
+  OverlayRenderer renderer(options);
   ImageBuffer video(160, 90, PixelFormat::rgb8);
   auto pixels = video.pixels_for_writing();
   for (std::size_t i = 0; i < pixels.size(); i += 3) pixels[i + 1] = std::byte{180};  // green
@@ -160,7 +174,7 @@ TEST(OverlayRenderer, VideoFrameIsTheLeftBackgroundInAnyPixelFormat) {
 }
 
 TEST(OverlayRenderer, MissingJointsAndEmptyFramesDraw) {
-  const OverlayRenderer renderer(OverlayOptions{});
+  OverlayRenderer renderer(OverlayOptions{});
   People2D people2d;
   people2d.layout = LayoutId::body25;
   Person2D p = person2d(3, 600.0f);
@@ -206,76 +220,158 @@ TEST(UprightPositions, RemovesTheTiltOfACameraLookingDown) {
   EXPECT_EQ(upright_positions(unset), standing);
 }
 
-// --- joining the inputs by frame
+// --- the 3D panel: people placed by the fitting
 
-template <class T>
-std::shared_ptr<const T> message(std::int64_t frame) {
-  auto m = std::make_shared<T>();
-  m->header.frame = frame;
-  return m;
+// A camera 3 m above a level floor looking down by `pitch_deg`, and a person standing on that
+// floor `x` metres to the right of it and `ahead` metres in front (along the floor), placed as
+// the fitting places people: root-relative positions turned into the camera frame, root
+// translation, the floor in the camera frame.
+struct TiltedCamera {
+  float pitch_deg = 30.0f;
+  float height = 3.0f;
+  glm::vec3 up() const {
+    const float a = glm::radians(pitch_deg);
+    return {0.0f, -std::cos(a), -std::sin(a)};
+  }
+  glm::vec3 ahead() const {
+    const float a = glm::radians(pitch_deg);
+    return {0.0f, -std::sin(a), std::cos(a)};
+  }
+  GroundPlane ground() const { return {up(), height}; }
+  Person3D person(int id, float x, float ahead_m) const {
+    const glm::quat level_camera = glm::angleAxis(glm::pi<float>(), glm::vec3(1, 0, 0));
+    const glm::quat tilt = glm::rotation(glm::vec3(0, -1, 0), up());
+    Person3D p;
+    p.id = id;
+    p.placed = true;
+    p.root.rotation = tilt * level_camera;
+    const auto body = standing_body();  // ankles 0.9 m below the root
+    for (int j = 0; j < kBodyJoints; ++j)
+      p.positions[static_cast<size_t>(j)] = tilt * body[static_cast<size_t>(j)];
+    p.root.translation = x * glm::vec3(1, 0, 0) + (0.9f - height) * up() + ahead_m * this->ahead();
+    return p;
+  }
+};
+
+glm::vec3 joint(const ScenePerson& p, Joint j) { return p.joints[static_cast<size_t>(index(j))]; }
+
+bool in_right_panel(const OverlayRenderer& r, glm::vec2 p) {
+  return p.x >= float(r.panel_width()) && p.x < float(r.width()) && p.y >= 0.0f &&
+         p.y < float(r.height());
 }
 
-TEST(OverlayInputs, FramesAreReadyWhenBothPeopleArrivedInAnyOrder) {
-  OverlayInputs inputs(8, false);
-  inputs.add(message<People3D>(0));
-  EXPECT_TRUE(inputs.take_ready().empty());
-  inputs.add(message<People2D>(0));
-  inputs.add(message<People2D>(1));
-  auto ready = inputs.take_ready();
-  ASSERT_EQ(ready.size(), 1u);
-  EXPECT_EQ(ready[0].frame, 0);
-  inputs.add(message<People3D>(1));
-  ready = inputs.take_ready();
-  ASSERT_EQ(ready.size(), 1u);
-  EXPECT_EQ(ready[0].frame, 1);
-  EXPECT_EQ(inputs.dropped(), 0);
-  EXPECT_EQ(inputs.pending(), 0u);
+int pixels_near(const ImageBuffer& image, Rgb colour, int x_begin, int x_end) {
+  int count = 0;
+  for (int y = 0; y < image.height(); ++y) {
+    for (int x = x_begin; x < x_end; ++x) {
+      const auto* p = reinterpret_cast<const std::uint8_t*>(image.data()) +
+                      static_cast<size_t>(y) * image.stride() + static_cast<size_t>(x) * 3;
+      count +=
+          std::abs(p[0] - colour.b) + std::abs(p[1] - colour.g) + std::abs(p[2] - colour.r) < 20;
+    }
+  }
+  return count;
 }
 
-TEST(OverlayInputs, AFrameSkippedByOneStreamIsDroppedOnceALaterOneIsReady) {
-  OverlayInputs inputs(8, false);
-  inputs.add(message<People2D>(0));
-  inputs.add(message<People2D>(2));  // 2D skipped frame 1
-  inputs.add(message<People3D>(0));
-  inputs.add(message<People3D>(1));
-  inputs.add(message<People3D>(2));
-  const auto ready = inputs.take_ready();
-  ASSERT_EQ(ready.size(), 2u);
-  EXPECT_EQ(ready[1].frame, 2);
-  EXPECT_EQ(inputs.dropped(), 1);
+TEST(ScenePanel, PlacedPeopleStandWhereTheFitPutThemUprightOnTheFloorGrid) {
+  const TiltedCamera camera;
+  People3D people3d;
+  people3d.has_ground = true;
+  people3d.ground = camera.ground();
+  people3d.people = {camera.person(3, -1.0f, 4.0f), camera.person(5, 2.0f, 8.0f)};
+  OverlayRenderer renderer(OverlayOptions{768, 576});
+  const ImageBuffer image = renderer.render({}, people3d, {}, {0, 0.0});
+  const auto scene = scene_people(people3d, {}, scene_floor(people3d), 1.2f);
+  ASSERT_EQ(scene.size(), 2u);
+  std::array<glm::vec2, 2> roots;
+  for (std::size_t i = 0; i < 2; ++i) {
+    const ScenePerson& p = scene[i];
+    EXPECT_TRUE(p.placed);
+    EXPECT_EQ(joint(p, Joint::root), people3d.people[i].root.translation);
+    // Feet on the floor (ankles 0.9 m below the hips, the hips 0.9 m above the floor).
+    EXPECT_NEAR(renderer.scene_camera().floor_coordinates(joint(p, Joint::left_ankle)).y, 0.0f,
+                1e-4f);
+    for (const glm::vec3& q : p.joints)
+      EXPECT_TRUE(in_right_panel(renderer, renderer.scene_pixel(q))) << "person " << p.id;
+    const glm::vec2 spine =
+        renderer.scene_pixel((joint(p, Joint::root) + joint(p, Joint::neck)) / 2.0f);
+    EXPECT_TRUE(colour_near(image, spine, id_colour(p.id))) << "person " << p.id;
+    // Upright in the panel although the camera looks down 30 degrees: the head straight above
+    // the root.
+    const glm::vec2 head = renderer.scene_pixel(joint(p, Joint::head));
+    roots[i] = renderer.scene_pixel(joint(p, Joint::root));
+    EXPECT_NEAR(head.x, roots[i].x, 1.0f) << "person " << p.id;
+    EXPECT_LT(head.y, roots[i].y - 10.0f) << "person " << p.id;
+  }
+  // Person 5 stands farther and more to the right: higher up and to the right in the view.
+  EXPECT_LT(roots[1].y, roots[0].y);
+  EXPECT_GT(roots[1].x, roots[0].x);
+  // Both were placed: nobody stands in a row, and the floor grid is drawn.
+  EXPECT_GT(pixels_near(image, {56, 56, 56}, renderer.panel_width(), renderer.width()), 300);
 }
 
-TEST(OverlayInputs, BoundedWhenOneStreamStalls) {
-  OverlayInputs inputs(4, false);
-  for (int f = 0; f < 10; ++f) inputs.add(message<People3D>(f));
-  EXPECT_EQ(inputs.pending(), 4u);
-  EXPECT_EQ(inputs.dropped(), 6);
+TEST(ScenePanel, UnplacedPeopleStandInARowOnTheFloorBesidePlacedOnes) {
+  const TiltedCamera camera;
+  People3D people3d;
+  people3d.has_ground = true;
+  people3d.ground = camera.ground();
+  Person3D unplaced = camera.person(9, 0.0f, 0.0f);
+  unplaced.placed = false;
+  unplaced.root.translation = glm::vec3(0.0f);
+  people3d.people = {camera.person(3, 0.0f, 6.0f), unplaced};
+  OverlayRenderer renderer(OverlayOptions{768, 576});
+  const ImageBuffer image = renderer.render({}, people3d, {}, {0, 0.0});
+  const auto scene = scene_people(people3d, {}, people3d.ground, 1.2f);
+  ASSERT_EQ(scene.size(), 2u);
+  EXPECT_FALSE(scene[1].placed);
+  const glm::vec3 root = renderer.scene_camera().floor_coordinates(joint(scene[1], Joint::root));
+  EXPECT_NEAR(root.y, 0.95f, 1e-3f);  // core/scene.hpp display_root: hips 0.95 m above the floor
+  EXPECT_NEAR(renderer.scene_camera().floor_coordinates(joint(scene[1], Joint::head)).x, root.x,
+              1e-3f);  // stood upright on the floor
+  const glm::vec2 spine =
+      renderer.scene_pixel((joint(scene[1], Joint::root) + joint(scene[1], Joint::neck)) / 2.0f);
+  EXPECT_TRUE(colour_near(image, spine, id_colour(9)));
 }
 
-TEST(OverlayInputs, VideoIsWaitedForOnlyWhenAskedAndUnusedVideoIsNotADrop) {
-  OverlayInputs waits(8, true);
-  waits.add(message<People2D>(0));
-  waits.add(message<People3D>(0));
-  EXPECT_TRUE(waits.take_ready().empty());
-  waits.add(message<VideoFrame>(0));
-  const auto ready = waits.take_ready();
-  ASSERT_EQ(ready.size(), 1u);
-  EXPECT_TRUE(ready[0].video);
-  OverlayInputs takes_what_came(8, false);
-  takes_what_came.add(message<VideoFrame>(0));  // the detector skipped this one
-  takes_what_came.add(message<VideoFrame>(1));
-  takes_what_came.add(message<People2D>(1));
-  takes_what_came.add(message<People3D>(1));
-  const auto drawn = takes_what_came.take_ready();
-  ASSERT_EQ(drawn.size(), 1u);
-  EXPECT_TRUE(drawn[0].video);
-  EXPECT_EQ(takes_what_came.dropped(), 0);
-  // At the end, frames with both people are drawn even without their video.
-  waits.add(message<People2D>(5));
-  waits.add(message<People3D>(5));
-  waits.add(message<People3D>(6));
-  EXPECT_EQ(waits.take_remaining().size(), 1u);
-  EXPECT_EQ(waits.dropped(), 1);
+TEST(ScenePanel, FloorIsTheKnownOneElseUnderThePlacedFeetElseAssumed) {
+  const TiltedCamera camera;
+  People3D people3d;
+  people3d.people = {camera.person(1, 0.0f, 5.0f)};
+  const GroundPlane under_feet = scene_floor(people3d);  // level in the image, through the ankles
+  EXPECT_EQ(under_feet.normal, glm::dvec3(0, -1, 0));
+  const glm::vec3 ankle =
+      people3d.people[0].root.translation + people3d.people[0].positions[index(Joint::left_ankle)];
+  EXPECT_NEAR(under_feet.offset, ankle.y, 1e-5f);
+  people3d.has_ground = true;
+  people3d.ground = camera.ground();
+  EXPECT_EQ(scene_floor(people3d).normal, glm::dvec3(camera.up()));
+  people3d = {};
+  EXPECT_EQ(scene_floor(people3d).offset, assumed_ground().offset);
+}
+
+// The view takes in someone far away in the very frame they appear, and comes back slowly when
+// they are gone.
+TEST(ScenePanel, ViewGrowsAtOnceAndShrinksSlowly) {
+  const TiltedCamera camera;
+  People3D near_only;
+  near_only.has_ground = true;
+  near_only.ground = camera.ground();
+  near_only.people = {camera.person(1, 0.0f, 4.0f)};
+  People3D with_far = near_only;
+  with_far.people.push_back(camera.person(2, 6.0f, 25.0f));
+  OverlayRenderer renderer(OverlayOptions{768, 576});
+  renderer.render({}, near_only, {}, {0, 0.0});
+  const float close_up = renderer.scene_camera().pixels_per_metre();
+  renderer.render({}, with_far, {}, {1, 0.0});
+  const float wide = renderer.scene_camera().pixels_per_metre();
+  EXPECT_LT(wide, close_up / 2.0f);
+  for (const ScenePerson& p : scene_people(with_far, {}, with_far.ground, 1.2f))
+    for (const glm::vec3& q : p.joints)
+      EXPECT_TRUE(in_right_panel(renderer, renderer.scene_pixel(q))) << "person " << p.id;
+  renderer.render({}, near_only, {}, {2, 0.0});
+  EXPECT_LT(renderer.scene_camera().pixels_per_metre(), 1.2f * wide);  // no jump back
+  for (int f = 3; f < 100; ++f) renderer.render({}, near_only, {}, {f, 0.0});
+  EXPECT_NEAR(renderer.scene_camera().pixels_per_metre(), close_up, 0.02f * close_up);
 }
 
 }  // namespace

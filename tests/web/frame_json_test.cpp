@@ -171,6 +171,23 @@ TEST(Recording, WithoutTimesFramesAreSpacedByTheFrameRate) {
   EXPECT_NEAR(r.times[2], 0.08, 1e-9);
 }
 
+// A writer killed in the middle of a line leaves it without its newline: skipped, said.
+TEST(Recording, ALastLineCutByAKillIsSkipped) {
+  TempDir dir;
+  const std::string path = dir.file("cut.jsonl");
+  test::write_file(
+      path,
+      "{\"time\": 0, \"people\": []}\n{\"time\": 0.1, \"people\": []}\n{\"time\": 0.2, \"peo");
+  const Recording r = read_poses_jsonl(path);
+  EXPECT_EQ(r.frames.size(), 2u);
+  EXPECT_TRUE(r.cut_last_line);
+  test::write_file(path, "{\"time\": 0, \"people\": []}\n");
+  EXPECT_FALSE(read_poses_jsonl(path).cut_last_line);
+  // A cut line alone is not a recording.
+  test::write_file(path, "{\"time\": 0, \"peo");
+  EXPECT_THROW(read_poses_jsonl(path), InputError);
+}
+
 TEST(Recording, GarbageIsAnErrorNamingTheFileAndLine) {
   TempDir dir;
   const std::string path = dir.file("bad.jsonl");
@@ -184,7 +201,10 @@ TEST(Recording, GarbageIsAnErrorNamingTheFileAndLine) {
     return "no error";
   };
   EXPECT_NE(message("").find("bad.jsonl: no frames"), std::string::npos);
-  EXPECT_NE(message("{\"people\": []}\n{\"people\": [{\"id\": 1, \"joi").find("bad.jsonl:2:"),
+  EXPECT_NE(message("{\"people\": []}\n{\"people\": [{\"id\": 1, \"joi\n").find("bad.jsonl:2:"),
+            std::string::npos);
+  EXPECT_NE(message("{\"people\": []}\n{\"people\": [{\"id\": 1, \"joi\n{\"people\": []}\n")
+                .find("bad.jsonl:2:"),
             std::string::npos);
   EXPECT_NE(message("{\"people\": [{\"id\": 1, \"joints\": {\"head\": [0, 0, 0]}}]}\n")
                 .find("has no joint 'neck'"),

@@ -1,17 +1,21 @@
 // `mocap-bench-fit`: the skeleton fitting (components/fit) measured on the virtual protocol with
 // known cameras. Held-out CMU clips are rendered through virtual cameras, reconstructed by the
 // retrieval (path + Savitzky-Golay + ray + view, the offline "full" configuration) on a train
-// database, then fitted in full-sequence and in fixed-lag live mode. Prints MPJPE, PA-MPJPE and
-// acceleration error before and after fitting, root translation error, foot skating during
-// (truth) contact, ground penetration, and the fitting's person-frames per second on one core.
+// database, then fitted in full-sequence mode (one solve, and in overlapping windows as recon.fit's
+// full mode does) and in fixed-lag live mode, per clip length (--max-frames 120,0). Prints MPJPE,
+// PA-MPJPE and acceleration error before and after fitting, root translation error, foot skating
+// during (truth) contact, ground penetration, and the fitting's person-frames per CPU second
+// (one thread) with its iterations.
 
 #include <algorithm>
-#include <chrono>
+#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
 #include <map>
+#include <sstream>
+#include <tuple>
 
 #include "cli_args.hpp"
 #include "core/input_error.hpp"
@@ -28,35 +32,53 @@
 namespace {
 
 using namespace mocap;
-using Clock = std::chrono::steady_clock;
 
 struct Row {
   eval::Scores pose;
   fit::PlacementScores placement;
-  double seconds = 0, frames = 0;  // fitting time (not retrieval)
+  double seconds = 0, frames = 0;  // fitting CPU time (not retrieval)
+  double solves = 0, iterations = 0, frame_iterations = 0;
   void add(const Row& o) {
     pose.add(o.pose);
     placement.add(o.placement);
     seconds += o.seconds;
     frames += o.frames;
+    solves += o.solves;
+    iterations += o.iterations;
+    frame_iterations += o.frame_iterations;
+  }
+  void add(const fit::FitStats& s) {
+    solves += s.solves;
+    iterations += s.iterations;
+    frame_iterations += s.frame_iterations;
   }
 };
 
-double seconds_since(Clock::time_point t) {
-  return std::chrono::duration<double>(Clock::now() - t).count();
+// CPU seconds of this process (the machine is shared: wall time would count other work).
+double cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
 }
 
-void print_row(const std::string& name, const std::string& condition, const Row& r) {
+void print_row(const std::string& name, const std::string& length, const std::string& condition,
+               const Row& r) {
   const auto& p = r.placement;
-  std::cout << "| " << name << " | " << condition << " | " << std::fixed << std::setprecision(1)
-            << r.pose.mpjpe() << " | " << r.pose.pa_mpjpe() << " | " << r.pose.accel() << " | "
-            << p.root_error_mm() << " | " << std::setprecision(2) << p.skate_cm() << " | "
-            << p.penetration_cm() << " | " << std::setprecision(1) << p.penetrating_percent()
-            << " | ";
+  std::cout << "| " << name << " | " << length << " | " << condition << " | " << std::fixed
+            << std::setprecision(1) << r.pose.mpjpe() << " | " << r.pose.pa_mpjpe() << " | "
+            << r.pose.accel() << " | " << p.root_error_mm() << " | " << std::setprecision(2)
+            << p.skate_cm() << " | " << p.penetration_cm() << " | " << std::setprecision(1)
+            << p.penetrating_percent() << " | ";
   if (r.seconds > 0)
     std::cout << std::setprecision(0) << r.frames / r.seconds;
   else
     std::cout << "-";
+  std::cout << " | ";
+  if (r.solves > 0)
+    std::cout << std::setprecision(1) << r.iterations / r.solves << " | "
+              << r.frame_iterations / r.frames;
+  else
+    std::cout << "- | -";
   std::cout << " |\n";
 }
 
@@ -145,7 +167,15 @@ int main(int argc, char** argv) {
       .option("eval-split", "NAME", "split of splits.txt whose clips are evaluated", "heldout")
       .option("eval-clips", "A,B", "only these clips of the split (names, e.g. 08_01,08_02)")
       .option("eval-files", "A.bvh,B.bvh", "evaluate these mocap files instead of a split")
-      .option("max-frames", "N", "frames per clip at most (0 = all)", "240")
+      .option("max-frames", "N[,M]",
+              "frames per clip at most (0 = all); a list gives the rows per clip length "
+              "(120,0: the first 120 frames and the whole clips, each retrieved on its own)",
+              "240")
+      .option("windows", "N:M[,N:M]",
+              "windowed full mode: frames solved together : frames of a window solved again in "
+              "the next; a list gives a row each (same retrieval)",
+              "64:16")
+      .option("iterations", "N", "full modes: solver iterations per solve (window)", "30")
       .option("lag", "N", "live mode: frames of delay", "3")
       .option("live-iterations", "N", "live mode: solver iterations per frame", "8")
       .option("clearance", "M", "ankle height over the ground plane", "0.07")
@@ -202,14 +232,21 @@ int main(int argc, char** argv) {
     auto truth = eval::load_truth(files, fps);
     if (const long n = args.integer("clips"); n > 0 && static_cast<std::size_t>(n) < truth.size())
       truth.resize(n);
-    if (const long n = args.integer("max-frames"); n > 0)
-      for (auto& t : truth)
-        if (t.world.size() > static_cast<std::size_t>(n)) t.world.resize(n);
+    std::vector<std::size_t> lengths;
+    for (const auto& text : split_commas(args.get("max-frames"))) {
+      char* end = nullptr;
+      const long n = std::strtol(text.c_str(), &end, 10);
+      if (end == text.c_str() || *end != '\0' || n < 0)
+        throw InputError("--max-frames", "expected frame counts (0 = all), got '" + text + "'");
+      lengths.push_back(static_cast<std::size_t>(n));
+    }
+    if (lengths.empty()) throw InputError("--max-frames", "no frame count given");
     const auto cameras = eval::default_cameras(!args.has("all-cameras"));
     const auto conditions = eval::default_conditions(!args.has("all-conditions"));
     const eval::Image image;
     const camera::Camera lens =
         camera::Camera::from_fov(image.width, image.height, image.horizontal_fov_deg);
+    const recon::Pinhole pinhole = recon::pinhole_of(lens);  // what components/fit takes
 
     recon::Matcher matcher(db, {});
     const recon::FrameBones bones(db);
@@ -222,11 +259,27 @@ int main(int argc, char** argv) {
     retrieval.refine_view = true;
 
     fit::FitOptions options;
-    options.camera = recon::pinhole_of(lens);
+    options.camera = pinhole;
     options.ankle_clearance_m = args.number("clearance");
     if (!args.has("no-ground")) options.ground = fit::GroundPlane{{0.0, 1.0, 0.0}, 0.0};
     options.lag = static_cast<int>(args.integer("lag"));
     options.live_iterations = static_cast<int>(args.integer("live-iterations"));
+    options.max_iterations = static_cast<int>(args.integer("iterations"));
+    std::vector<fit::WindowOptions> windows;
+    for (const auto& text : split_commas(args.get("windows"))) {
+      fit::WindowOptions w;
+      char colon = 0;
+      std::istringstream in(text);
+      if (!(in >> w.frames >> colon >> w.overlap) || colon != ':' || !in.eof() || w.frames < 2 ||
+          w.overlap < 1 || w.overlap >= w.frames)
+        throw InputError("--windows",
+                         "expected FRAMES:OVERLAP (overlap 1 .. frames - 1), got '" + text + "'");
+      windows.push_back(w);
+    }
+    if (windows.empty()) throw InputError("--windows", "no window given");
+    auto window_name = [](const fit::WindowOptions& w) {
+      return "+ fit, full windowed " + std::to_string(w.frames) + ":" + std::to_string(w.overlap);
+    };
     options.solve_bones = !args.has("fixed-bones");
     options.weights.prior_rad = args.number("prior");
     options.weights.reprojection = args.number("reprojection");
@@ -238,119 +291,147 @@ int main(int argc, char** argv) {
     const bool use_contact = !args.has("no-contact");
     const auto variants = make_variants(options, args.all("sweep"), args.all("variant"));
 
-    const std::vector<std::string> methods = {"truth", "retrieval only", "+ fit, full sequence",
-                                              "+ fit, live"};
-    std::map<std::pair<std::string, std::string>, Row> rows;
-    std::size_t frames = 0;
+    // truth, retrieval, one solve, the windows, live.
+    std::vector<std::string> methods = {"truth", "retrieval only",
+                                        "+ fit, full sequence (one solve)"};
+    for (const auto& w : windows) methods.push_back(window_name(w));
+    methods.push_back("+ fit, live");
+    const std::string& live_method = methods.back();
+    // Rows by (method [variant], clip length, condition).
+    std::map<std::tuple<std::string, std::string, std::string>, Row> rows;
+    std::vector<std::string> length_labels;
     std::cout << "## Skeleton fitting, virtual protocol\n\nclip floors (lowest ankle, m):";
-    for (const auto& t : truth) {
-      frames += t.world.size();
+    for (const auto& t : truth)
       std::cout << " " << t.clip << " " << std::setprecision(3) << fit::ankle_floor(t.world);
-    }
     std::cout << "\n\n";
-    std::cerr << truth.size() << " clips, " << frames << " frames, " << cameras.size()
-              << " cameras, " << conditions.size() << " conditions\n";
-    for (std::size_t n = 0; n < conditions.size(); ++n) {
-      const std::string cond = conditions[n].label();
-      for (std::size_t k = 0; k < cameras.size(); ++k) {
-        for (std::size_t s = 0; s < truth.size(); ++s) {
-          const auto rendered = eval::render(truth[s], cameras[k], image, conditions[n],
-                                             1000003ull * s + 1009ull * k + n);
-          const auto& world = truth[s].world;
-          const auto poses = recon::reconstruct_sequence(matcher, bones, rendered.input, retrieval);
-          const auto cams = fit::camera_poses(world, rendered.truth_camera);
-          const auto inputs = fit::make_inputs(
-              rendered.input, poses,
-              use_contact ? detector.contacts(poses) : std::vector<std::array<bool, 2>>{}, cams);
-          const auto contacts = fit::truth_contacts(world, fps);
-          const double floor = fit::ankle_floor(world);
-          auto placement = [&](const std::vector<fit::FittedFrame>& f) {
-            return fit::score_placement(f, rendered.truth_camera, cams, contacts, floor);
-          };
-          // The truth itself (skating and penetration of the reference).
-          {
+    for (const std::size_t length : lengths) {
+      const std::string len = length == 0 ? "whole" : "<=" + std::to_string(length);
+      length_labels.push_back(len);
+      std::vector<eval::TruthSequence> clips = truth;
+      std::size_t frames = 0;
+      for (auto& t : clips) {
+        if (length > 0 && t.world.size() > length) t.world.resize(length);
+        frames += t.world.size();
+      }
+      std::cerr << clips.size() << " clips (" << len << " frames), " << frames << " frames, "
+                << cameras.size() << " cameras, " << conditions.size() << " conditions\n";
+      for (std::size_t n = 0; n < conditions.size(); ++n) {
+        const std::string cond = conditions[n].label();
+        for (std::size_t k = 0; k < cameras.size(); ++k) {
+          for (std::size_t s = 0; s < clips.size(); ++s) {
+            const auto rendered = eval::render(clips[s], cameras[k], image, conditions[n],
+                                               1000003ull * s + 1009ull * k + n);
+            const auto& world = clips[s].world;
+            const auto poses =
+                recon::reconstruct_sequence(matcher, bones, rendered.input, retrieval);
+            const auto cams = fit::camera_poses(world, rendered.truth_camera);
+            const auto inputs = fit::make_inputs(
+                rendered.input, poses,
+                use_contact ? detector.contacts(poses) : std::vector<std::array<bool, 2>>{}, cams);
+            const auto contacts = fit::truth_contacts(world, fps);
+            const double floor = fit::ankle_floor(world);
+            auto score = [&](const std::vector<fit::FittedFrame>& f, double start) {
+              Row r;
+              r.seconds = cpu_seconds() - start;
+              r.frames = static_cast<double>(inputs.size());
+              r.pose = eval::score(fit::as_poses(f), rendered.truth_camera);
+              r.placement = fit::score_placement(f, rendered.truth_camera, cams, contacts, floor);
+              return r;
+            };
+            // The truth itself (skating and penetration of the reference).
             std::vector<fit::FittedFrame> t(world.size());
             for (std::size_t i = 0; i < t.size(); ++i)
               t[i] = {true, true, rendered.truth_camera[i]};
-            Row r;
-            r.pose = eval::score(fit::as_poses(t), rendered.truth_camera);
-            r.placement = placement(t);
-            rows[{methods[0], cond}].add(r);
-          }
-          {
-            Row r;
-            r.pose = eval::score(poses, rendered.truth_camera);
-            r.placement = placement(fit::placed_retrieval(inputs, options.camera));
-            rows[{methods[1], cond}].add(r);
-          }
-          for (const auto& v : variants) {
-            const std::string suffix = v.label.empty() ? "" : " [" + v.label + "]";
-            {
-              const auto start = Clock::now();
-              const auto result = fit::fit_sequence(inputs, v.options);
-              Row r;
-              r.seconds = seconds_since(start);
-              r.frames = static_cast<double>(inputs.size());
-              r.pose = eval::score(fit::as_poses(result.frames), rendered.truth_camera);
-              r.placement = placement(result.frames);
-              rows[{methods[2] + suffix, cond}].add(r);
-            }
-            {
-              const auto start = Clock::now();
-              fit::LiveFitter live(v.options);
+            Row truth_row = score(t, cpu_seconds());
+            truth_row.seconds = 0;
+            rows[{methods[0], len, cond}].add(truth_row);
+            Row retrieved;
+            retrieved.pose = eval::score(poses, rendered.truth_camera);
+            retrieved.placement =
+                fit::score_placement(fit::placed_retrieval(inputs, pinhole), rendered.truth_camera,
+                                     cams, contacts, floor);
+            rows[{methods[1], len, cond}].add(retrieved);
+            for (const auto& v : variants) {
+              const std::string suffix = v.label.empty() ? "" : " [" + v.label + "]";
+              double start = cpu_seconds();
+              const auto one_solve = fit::fit_sequence(inputs, v.options);
+              Row row = score(one_solve.frames, start);
+              row.add(one_solve.stats);
+              rows[{methods[2] + suffix, len, cond}].add(row);
               std::vector<fit::FittedFrame> out;
+              for (const auto& w : windows) {
+                start = cpu_seconds();
+                fit::WindowedFitter windowed(v.options, w);
+                out.clear();
+                for (const auto& in : inputs)
+                  for (auto& f : windowed.push(in)) out.push_back(f);
+                for (auto& f : windowed.finish()) out.push_back(f);
+                row = score(out, start);
+                row.add(windowed.stats());
+                rows[{window_name(w) + suffix, len, cond}].add(row);
+              }
+              start = cpu_seconds();
+              fit::LiveFitter live(v.options);
+              out.clear();
               for (const auto& in : inputs)
                 if (auto f = live.push(in)) out.push_back(*f);
               for (auto& f : live.finish()) out.push_back(f);
-              Row r;
-              r.seconds = seconds_since(start);
-              r.frames = static_cast<double>(inputs.size());
-              r.pose = eval::score(fit::as_poses(out), rendered.truth_camera);
-              r.placement = placement(out);
-              rows[{methods[3] + suffix, cond}].add(r);
+              row = score(out, start);
+              row.add(live.stats());
+              rows[{live_method + suffix, len, cond}].add(row);
             }
+            std::cerr << "." << std::flush;
           }
-          std::cerr << "." << std::flush;
         }
       }
+      std::cerr << "\n";
     }
-    std::cerr << "\n";
     std::cout << truth.size() << " clips ("
-              << (args.has("eval-files") ? "files" : args.get("eval-split")) << "; first "
-              << args.get("max-frames") << " frames each), " << frames << " frames at " << fps
-              << " fps, " << cameras.size() << " cameras; live: lag " << options.lag << ", "
+              << (args.has("eval-files") ? "files" : args.get("eval-split"))
+              << "; frames each: " << args.get("max-frames") << ", 0 = whole) at " << fps
+              << " fps, " << cameras.size() << " cameras; full: " << options.max_iterations
+              << " iterations per solve; live: lag " << options.lag << ", "
               << options.live_iterations << " iterations; ground plane "
               << (options.ground ? "given" : "none") << ", ankle clearance "
               << options.ankle_clearance_m << " m\n\n"
-              << "| method | condition | MPJPE mm | PA-MPJPE mm | accel mm/f² | root err mm | "
-                 "skate cm/f | below floor cm | ankle-frames >1 cm below % | fit person-frames/s "
-                 "|\n|---|---|---:|---:|---:|---:|---:|---:|---:|---:|\n";
-    for (const auto& m : methods) {
-      Row all;
-      for (const auto& c : conditions) {
-        print_row(m, c.label(), rows[{m, c.label()}]);
-        all.add(rows[{m, c.label()}]);
+              << "| method | clip frames | condition | MPJPE mm | PA-MPJPE mm | accel mm/f² | root "
+                 "err mm | skate cm/f | below floor cm | ankle-frames >1 cm below % | fit "
+                 "person-frames per CPU s | iterations per solve | frames × iterations per frame "
+                 "|\n|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+    for (const auto& len : length_labels) {
+      for (const auto& m : methods) {
+        Row all;
+        for (const auto& c : conditions) {
+          print_row(m, len, c.label(), rows[{m, len, c.label()}]);
+          all.add(rows[{m, len, c.label()}]);
+        }
+        print_row(m, len, "all", all);
       }
-      print_row(m, "all", all);
     }
     if (variants.size() > 1) {
-      std::cout << "\nWeight variants (rows \"all\": every condition; the base is the options "
-                   "given):\n\n| variant | full MPJPE mm | full PA-MPJPE mm | full root err mm | "
-                   "full skate cm/f | live MPJPE mm | live PA-MPJPE mm | live root err mm | live "
-                   "accel mm/f² |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|\n";
-      for (const auto& v : variants) {
-        const std::string suffix = v.label.empty() ? "" : " [" + v.label + "]";
-        Row full, live;
-        for (const auto& c : conditions) {
-          full.add(rows[{methods[2] + suffix, c.label()}]);
-          live.add(rows[{methods[3] + suffix, c.label()}]);
+      std::cout
+          << "\nWeight variants (rows \"all\": every condition; the base is the options "
+             "given):\n\n| variant | clip frames | full MPJPE mm | full PA-MPJPE mm | full "
+             "root err mm | full skate cm/f | windowed (first) MPJPE mm | live MPJPE mm | live "
+             "PA-MPJPE mm | live root err mm | live accel mm/f² "
+             "|\n|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+      for (const auto& len : length_labels) {
+        for (const auto& v : variants) {
+          const std::string suffix = v.label.empty() ? "" : " [" + v.label + "]";
+          Row full, windowed, live;
+          for (const auto& c : conditions) {
+            full.add(rows[{methods[2] + suffix, len, c.label()}]);
+            windowed.add(rows[{methods[3] + suffix, len, c.label()}]);
+            live.add(rows[{live_method + suffix, len, c.label()}]);
+          }
+          std::cout << "| " << (v.label.empty() ? "base" : v.label) << " | " << len << " | "
+                    << std::fixed << std::setprecision(1) << full.pose.mpjpe() << " | "
+                    << full.pose.pa_mpjpe() << " | " << full.placement.root_error_mm() << " | "
+                    << std::setprecision(2) << full.placement.skate_cm() << " | "
+                    << std::setprecision(1) << windowed.pose.mpjpe() << " | " << live.pose.mpjpe()
+                    << " | " << live.pose.pa_mpjpe() << " | " << live.placement.root_error_mm()
+                    << " | " << live.pose.accel() << " |\n";
         }
-        std::cout << "| " << (v.label.empty() ? "base" : v.label) << " | " << std::fixed
-                  << std::setprecision(1) << full.pose.mpjpe() << " | " << full.pose.pa_mpjpe()
-                  << " | " << full.placement.root_error_mm() << " | " << std::setprecision(2)
-                  << full.placement.skate_cm() << " | " << std::setprecision(1) << live.pose.mpjpe()
-                  << " | " << live.pose.pa_mpjpe() << " | " << live.placement.root_error_mm()
-                  << " | " << live.pose.accel() << " |\n";
       }
     }
     std::cout << "\nRetrieval: path + Savitzky-Golay (3, 11) + ray + view refinement on "

@@ -4,6 +4,8 @@
 //
 // Throughput: a producer thread sends as fast as a blocking(16) edge lets it. Latency: one
 // message at a time (the next leaves when the previous arrived), send to receive, one way.
+// A second table: the synchroniser of joined inputs alone (graph/synchronizer.hpp), sets per
+// second for 2 to 16 inputs, in order or with one input 100 frames late, in one thread.
 
 #include <unistd.h>
 #include <atomic>
@@ -17,6 +19,7 @@
 #include "cli_args.hpp"
 #include "graph/inbox.hpp"
 #include "graph/stats.hpp"
+#include "graph/synchronizer.hpp"
 #include "graph/transport.hpp"
 
 namespace {
@@ -129,13 +132,44 @@ void print_row(const std::string& transport, const Payload& payload, const Resul
   std::cout << line << std::flush;
 }
 
+// Sets per second through a synchroniser of `inputs` inputs: every input sends frames 0..sets-1;
+// with `lag`, input 0 runs `lag` frames ahead of the others (held meanwhile).
+double sync_sets_per_second(std::size_t inputs, int sets, int lag) {
+  Synchronizer sync(inputs, {SyncKey::frame, 0, std::chrono::nanoseconds(0),
+                             static_cast<std::size_t>(lag + 16), AtBound::pass_partial});
+  std::vector<Packet> messages;  // made beforehand: the table measures the joining only
+  for (int f = 0; f < sets; ++f) {
+    auto m = std::make_shared<People2D>();
+    m->header.frame = f;
+    messages.push_back(Packet::of<People2D>(std::move(m)));
+  }
+  SyncSet set;
+  std::uint64_t passed = 0;
+  const auto start = Clock::now();
+  for (int f = 0; f < sets + lag; ++f) {
+    const auto now = Clock::now();
+    if (f < sets) sync.push(0, messages[static_cast<std::size_t>(f)], now);
+    if (f >= lag) {
+      for (std::size_t i = 1; i < inputs; ++i) {
+        sync.push(i, messages[static_cast<std::size_t>(f - lag)], now);
+      }
+    }
+    while (sync.pop(now, set)) passed += set.complete() ? 1 : 0;
+  }
+  const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  if (passed != static_cast<std::uint64_t>(sets)) throw std::logic_error("incomplete sets");
+  return sets / seconds;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  mocap::cli::Args args("mocap-bench-graph [--small N] [--frames N]",
-                        "Throughput and one-way latency of one graph edge per transport.");
+  mocap::cli::Args args("mocap-bench-graph [--small N] [--frames N] [--sets N]",
+                        "Throughput and one-way latency of one graph edge per transport, and "
+                        "sets per second through the synchroniser of joined inputs.");
   args.option("small", "N", "small messages per throughput run", "20000")
-      .option("frames", "N", "1920x1080 frames per throughput run", "300");
+      .option("frames", "N", "1920x1080 frames per throughput run", "300")
+      .option("sets", "N", "sets per synchroniser run", "200000");
   int exit_code = 0;
   if (!args.parse(argc - 1, argv + 1, exit_code)) return exit_code;
   const int small = static_cast<int>(args.integer("small"));
@@ -180,5 +214,18 @@ int main(int argc, char** argv) {
     }
   }
   std::filesystem::remove_all(ipc_dir);
+
+  const int sets = static_cast<int>(args.integer("sets"));
+  std::cout << "\n| joined inputs | arrival                    | sets/s       | ns per set |\n"
+               "|--------------:|----------------------------|-------------:|-----------:|\n";
+  for (const std::size_t inputs : {2u, 4u, 16u}) {
+    for (const int lag : {0, 100}) {
+      const double rate = sync_sets_per_second(inputs, sets, lag);
+      char line[160];
+      std::snprintf(line, sizeof line, "| %13zu | %-26s | %12.0f | %10.0f |\n", inputs,
+                    lag ? "others 100 frames late" : "in step", rate, 1e9 / rate);
+      std::cout << line << std::flush;
+    }
+  }
   return 0;
 }

@@ -1,6 +1,7 @@
 // mocap-bench-movenet: MoveNet MultiPose latency by input size and thread count on one real
-// frame: network forward (cv::dnn), decoding, and the input preparation, as medians and minima
-// over timed runs after warm-up. Prints a Markdown table.
+// frame: network forward (cv::dnn or XNNPACK), decoding, and the input preparation, as medians and
+// minima over timed runs after warm-up. Prints a Markdown table. (mocap-bench-networks compares the
+// runtimes on every network.)
 
 #include <algorithm>
 #include <chrono>
@@ -75,7 +76,8 @@ int main(int argc, char** argv) {
   args.option("image", "PNG", "frame to detect on",
               "../shared/docs/models/movenet-multipose/vtest-f300.png")
       .option("sizes", "LIST", "input long sides, multiples of 32", "192,256,384,512")
-      .option("threads", "LIST", "cv::setNumThreads values", "1,2")
+      .option("threads", "LIST", "network threads", "1,2")
+      .option("backend", "NAME", "network runtime: auto, xnnpack, opencv", "auto")
       .option("warmup", "N", "untimed runs per size", "3")
       .option("runs", "N", "timed runs per size", "30");
   int exit_code = 0;
@@ -86,16 +88,21 @@ int main(int argc, char** argv) {
     auto owner = std::make_shared<cv::Mat>(bgr);
     const ImageBuffer frame(bgr.cols, bgr.rows, static_cast<int>(bgr.step[0]), PixelFormat::bgr8,
                             owner, reinterpret_cast<const std::byte*>(owner->data));
-    auto start = Clock::now();
-    detect::MovenetNetwork net(detect::movenet_model_json());
-    std::printf("model load (TF.js -> GraphDef -> cv::dnn): %.0f ms; frame %dx%d\n\n",
-                ms_since(start), frame.width(), frame.height());
+    const detect::Backend backend =
+        detect::resolve_backend(detect::parse_backend(args.get("backend")));
+    std::printf("runtime %s; frame %dx%d\n\n", std::string(detect::backend_name(backend)).c_str(),
+                frame.width(), frame.height());
     std::printf(
         "| input (WxH) | threads | forward median | forward min | decode median | prepare median "
         "|\n");
     std::printf("|---|---|---|---|---|---|\n");
     for (const int threads : int_list(args.get("threads"))) {
-      cv::setNumThreads(threads);
+      detect::RunnerOptions options;
+      options.backend = backend;
+      options.threads = threads;
+      auto start = Clock::now();
+      detect::MovenetNetwork net(detect::movenet_model_json(), options);
+      std::fprintf(stderr, "model load with %d thread(s): %.0f ms\n", threads, ms_since(start));
       for (const int size : int_list(args.get("sizes"))) {
         const auto input = detect::prepare_movenet_input(frame, size);
         const Timing t = time_size(net, frame, size, static_cast<int>(args.integer("warmup")),

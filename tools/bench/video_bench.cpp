@@ -1,6 +1,8 @@
-// mocap-bench-video: the whole method on real videos, end to end (decode -> MoveNet -> tracker ->
+// mocap-bench-video: the whole method on real videos, end to end (decode -> detector -> tracker ->
 // scaler -> matcher -> temporal selection -> smoothing -> JSONL, BVH and overlay MP4), per video
-// and detector input size, in two runs each:
+// and detection strategy (mocap reconstruct --detector names; multipose ones per input size) x
+// network runtime x workers (detect.movenet only) x threads, in
+// two runs each:
 //  * offline: every frame, as fast as possible (the graph of `mocap reconstruct VIDEO`):
 //    frames per second, people per frame, tracks longer than 50 frames, id breaks and jumps;
 //  * live: the file replayed at its own rate like a camera, the detector on a `latest` edge and
@@ -9,6 +11,7 @@
 // Prints Markdown tables. A probe node in this program records what reaches the outputs.
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -21,6 +24,7 @@
 #include <vector>
 
 #include "cli_args.hpp"
+#include "detector_presets.hpp"
 #include "graph/graph_spec.hpp"
 #include "graph/registry.hpp"
 #include "graph/runtime.hpp"
@@ -163,11 +167,27 @@ TrackQuality track_quality(const Records& r) {
 
 struct RunSpec {
   std::string video, db, out_dir;
-  int size = 256;
+  std::string detector = "multipose";  // a preset of tools/mocap/detector_presets.hpp
+  int size = 256;                      // its input size when it is a multipose one
   bool live = false;
   int detector_threads = 0;
+  std::string backend = "auto";
+  int workers = 1;
   int lag = 8;
 };
+
+std::string detector_node(const RunSpec& s) {
+  const cli::DetectorPreset& preset = cli::detector_preset(s.detector);
+  std::ostringstream node;
+  node << "{ type: " << preset.type << ", params: { threads: " << s.detector_threads
+       << ", backend: " << s.backend;
+  // Copies on consecutive frames: detect.movenet only (the others follow people frame to frame).
+  if (preset.type == "detect.movenet") node << ", workers: " << s.workers;
+  for (const auto& [key, value] : preset.params)
+    node << ", " << key << ": " << (key == "input_size" ? std::to_string(s.size) : value);
+  node << " } }";
+  return node.str();
+}
 
 std::string graph_text(const RunSpec& s, const video::VideoSource& info, const std::string& probe) {
   const double fps = info.fps() > 0 ? info.fps() : 30.0;
@@ -175,8 +195,7 @@ std::string graph_text(const RunSpec& s, const video::VideoSource& info, const s
   g << "graph: bench_video\nnodes:\n"
     << "  src: { type: source.video, params: { path: \"" << s.video
     << "\", mode: " << (s.live ? "live" : "offline") << " } }\n"
-    << "  det: { type: detect.movenet, params: { input_size: " << s.size
-    << ", threads: " << s.detector_threads << " } }\n"
+    << "  det: " << detector_node(s) << "\n"
     << "  track: { type: recon.tracker }\n"
     << "  scale: { type: recon.scaler, params: { db: \"" << s.db << "\" } }\n"
     << "  match: { type: recon.matcher, params: { db: \"" << s.db << "\", k: 32, probe: 16 } }\n"
@@ -277,6 +296,17 @@ std::vector<std::string> split(const std::string& list) {
   return out;
 }
 
+// Every runtime x workers x threads x mode of the options, in that order.
+std::vector<std::array<std::string, 4>> matrix(const cli::Args& args) {
+  std::vector<std::array<std::string, 4>> out;
+  for (const std::string& backend : split(args.get("backends")))
+    for (const std::string& workers : split(args.get("workers")))
+      for (const std::string& threads : split(args.get("threads")))
+        for (const std::string& mode : split(args.get("modes")))
+          out.push_back({backend, workers, threads, mode});
+  return out;
+}
+
 }  // namespace
 }  // namespace mocap::bench
 
@@ -288,43 +318,66 @@ int main(int argc, char** argv) {
   args.option("videos", "LIST", "comma-separated video files",
               "/usr/share/doc/opencv-doc/examples/data/vtest.avi,"
               "../shared/data/eval/openpose_examples_media/video.avi")
-      .option("sizes", "LIST", "MoveNet input sizes", "256,384")
+      .option("detectors", "LIST",
+              "detection strategies (mocap reconstruct --detector names: " + cli::detector_names() +
+                  ")",
+              "multipose")
+      .option("sizes", "LIST", "MoveNet input sizes of the multipose detectors", "256,384")
       .option("db", "FILE", "pose database", "build/db/cmu31_train.mdb")
       .option("modes", "LIST", "offline, live or both", "offline,live")
-      .option("threads", "N", "detector threads (0: OpenCV's default)", "0")
+      .option("threads", "LIST", "detector threads per worker (0: the runtime's default)", "0")
+      .option("backends", "LIST", "detector runtimes: auto, xnnpack, opencv", "auto")
+      .option("workers", "LIST",
+              "detector workers (copies on consecutive frames; detect.movenet only)", "1")
       .option("lag", "N", "temporal selection look-ahead in frames", "8")
       .option("out", "DIR", "where each run's outputs go", "/tmp/mocap-bench-video");
   int exit_code = 0;
   if (!args.parse(argc - 1, argv + 1, exit_code)) return exit_code;
   try {
     std::cout
-        << "| video | size | mode | frames | 3D outputs | wall s | fps | people/frame (max) "
+        << "| video | detector | runtime | workers | threads | mode | frames | 3D outputs | "
+           "wall s | fps | people/frame (max) "
            "| 3D people/frame | tracks | tracks > 50 | id breaks | id jumps | latency p50 "
            "ms | p95 ms | p50 first / last quarter ms | src skips | det drops | det p50 ms |\n"
-        << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+        << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+           "---|\n";
     for (const std::string& video : split(args.get("videos"))) {
       if (!std::filesystem::exists(video)) {
         std::cout << "| " << video << " | absent, skipped |\n";
         continue;
       }
-      for (const std::string& size : split(args.get("sizes"))) {
-        for (const std::string& mode : split(args.get("modes"))) {
+      std::vector<std::pair<std::string, std::string>> variants;  // detector, size
+      for (const std::string& detector : split(args.get("detectors"))) {
+        if (cli::detector_preset(detector).type != "detect.movenet") {
+          variants.emplace_back(detector, "");
+          continue;
+        }
+        for (const std::string& size : split(args.get("sizes")))
+          variants.emplace_back(detector, size);
+      }
+      for (const auto& [detector, size] : variants) {
+        const std::string label = size.empty() ? detector : detector + "@" + size;
+        for (const auto& [backend, workers, threads, mode] : matrix(args)) {
           RunSpec spec;
+          spec.backend = backend;
+          spec.workers = std::stoi(workers);
           spec.video = video;
           spec.db = args.get("db");
-          spec.size = std::stoi(size);
+          spec.detector = detector;
+          if (!size.empty()) spec.size = std::stoi(size);
           spec.live = mode == "live";
-          spec.detector_threads = std::stoi(args.get("threads"));
+          spec.detector_threads = std::stoi(threads);
           spec.lag = std::stoi(args.get("lag"));
           spec.out_dir = args.get("out") + "/" + std::filesystem::path(video).stem().string() +
-                         "_" + size + "_" + mode;
+                         "_" + label + "_" + backend + "_w" + workers + "_t" + threads + "_" + mode;
           const Result r = run(spec);
           std::cout << std::fixed << std::setprecision(1) << "| "
-                    << std::filesystem::path(video).filename().string() << " | " << size << " | "
-                    << mode << " | " << r.frames << " | " << r.outputs << " | " << r.wall_s << " | "
-                    << r.fps << " | " << std::setprecision(2) << r.people_mean << " ("
-                    << r.people_max << ") | " << r.people3d_mean << " | " << r.quality.tracks
-                    << " | " << r.quality.long_tracks << " | " << r.quality.breaks << " | "
+                    << std::filesystem::path(video).filename().string() << " | " << label << " | "
+                    << backend << " | " << workers << " | " << threads << " | " << mode << " | "
+                    << r.frames << " | " << r.outputs << " | " << r.wall_s << " | " << r.fps
+                    << " | " << std::setprecision(2) << r.people_mean << " (" << r.people_max
+                    << ") | " << r.people3d_mean << " | " << r.quality.tracks << " | "
+                    << r.quality.long_tracks << " | " << r.quality.breaks << " | "
                     << r.quality.jumps << " | " << std::setprecision(0);
           if (spec.live) {  // offline frames carry their time in the video, not a capture time
             std::cout << r.latency_p50_ms << " | " << r.latency_p95_ms << " | "

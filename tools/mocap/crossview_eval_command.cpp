@@ -32,6 +32,7 @@
 #include "fit/foot_contact.hpp"
 #include "fit/view_fit.hpp"
 #include "fit_cameras.hpp"
+#include "output_files.hpp"
 #include "posedb/parallel_chunks.hpp"
 #include "progress_bar.hpp"
 #include "recon/layout_offsets.hpp"
@@ -186,16 +187,20 @@ int crossview_eval_command(int argc, char** argv) {
               "(calibration/layouts/body25b.yaml), as `mocap reconstruct` does for JSON",
               "auto")
       .option("json", "FILE", "where to write all numbers", "eval_crossview.json")
-      .option("threads", "N", "worker threads", "2")
-      .option("max-frames", "N", "HumanEva: frames per chunk at most, database rate (0 = all)", "0")
-      .option("clearance", "M", "ankle height over the floor the ground term keeps", "0.07")
+      .option("threads", "N", "worker threads", "2", Range::count(1, 64))
+      .option("max-frames", "N", "HumanEva: frames per chunk at most, database rate (0 = all)", "0",
+              Range::count(0, std::numeric_limits<int>::max()))
+      .option("clearance", "M", "ankle height over the floor the ground term keeps", "0.07",
+              Range::between(0.0, 0.5))
       .flag("no-ground", "no ground plane (default: the world's Z = 0 floor of both datasets)")
       .flag("quick", "HumanEva: the first 48 frames (2 s) of every chunk");
   int code = 0;
   if (!args.parse(argc, argv, code)) return code;
   if (!args.has("db")) throw InputError("--db", "required: a pose database");
   const auto started = std::chrono::steady_clock::now();
-  const int threads = static_cast<int>(std::clamp(args.integer("threads"), 1L, 64L));
+  refuse_output_over_inputs({"--json", args.get("json")},
+                            {{"--db", args.get("db")}, {"--calibration", args.get("calibration")}});
+  const int threads = static_cast<int>(args.integer("threads"));
   const posedb::Database db = posedb::Database::open(args.get("db"));
   const double fps = db.build_info().fps;
   const std::string datasets = args.get("datasets");

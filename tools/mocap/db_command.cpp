@@ -13,6 +13,7 @@
 #include "commands.hpp"
 #include "core/input_error.hpp"
 #include "core/keypoint_layout.hpp"
+#include "output_files.hpp"
 #include "posedb/builder.hpp"
 #include "posedb/cluster_search.hpp"
 #include "posedb/database.hpp"
@@ -24,21 +25,6 @@ namespace mocap::cli {
 namespace {
 
 using nlohmann::json;
-
-std::vector<float> parse_float_list(const std::string& text, const std::string& option) {
-  std::vector<float> out;
-  std::stringstream in(text);
-  for (std::string item; std::getline(in, item, ',');) {
-    try {
-      size_t used = 0;
-      out.push_back(std::stof(item, &used));
-      if (used != item.size()) throw std::invalid_argument(item);
-    } catch (const std::exception&) {
-      throw InputError("--" + option, "expected comma-separated numbers, got '" + text + "'");
-    }
-  }
-  return out;
-}
 
 std::string joined_command(const char* name, int argc, char** argv) {
   std::string s = std::string("mocap db ") + name;
@@ -89,20 +75,24 @@ int build(int argc, char** argv) {
             "several yaws\n"
             "and heights; the normalised projections are clustered for fast search.");
   args.positional("PATH", "BVH/AMC files or folders (searched recursively)", true)
-      .option("out", "FILE", "database file to write")
-      .option("fps", "N", "frame rate of the database", "24")
-      .option("yaw-steps", "N", "camera yaw steps around the person (30 = every 12 degrees)", "30")
-      .option("heights", "LIST", "camera heights in metres, comma-separated", "1.5,2.5,4,6")
-      .option("distance", "M", "horizontal camera distance in metres", "4")
+      .option("out", "FILE", "database file to write (through a temporary file)")
+      .option("fps", "N", "frame rate of the database", "24", Range::between(1.0, 1000.0))
+      .option("yaw-steps", "N", "camera yaw steps around the person (30 = every 12 degrees)", "30",
+              Range::count(1, 3600))
+      .option("heights", "LIST", "camera heights in metres, comma-separated", "1.5,2.5,4,6",
+              Range::positive_list())
+      .option("distance", "M", "horizontal camera distance in metres", "4", Range::positive())
       .option("scaling", "MODE", "2D normalisation: bbox_height (paper) or bone_length",
               "bbox_height")
       .option("body", "NAME",
               "canonical: every family rescaled to one body (CMU-train median bones, bone "
               "directions kept;\nsee docs/body15.md), source: each skeleton's own proportions",
               "canonical")
-      .option("clusters", "N", "k-means clusters (0 = about sqrt(projections))", "0")
-      .option("seed", "N", "random seed for k-means", "1")
-      .option("threads", "N", "worker threads", "2")
+      .option("clusters", "N", "k-means clusters (0 = about sqrt(projections))", "0",
+              Range::count(0, 100'000'000))
+      .option("seed", "N", "random seed for k-means", "1",
+              Range::count(0, std::numeric_limits<long>::max()))
+      .option("threads", "N", "worker threads", "2", Range::count(1, 64))
       .option("split", "NAME",
               "only the files a folder's splits.txt assigns to NAME (e.g. train); a folder "
               "without\nsplits.txt (bandai/) is taken whole. Never give cmu_daz/ for a training "
@@ -114,7 +104,8 @@ int build(int argc, char** argv) {
   posedb::BuildOptions options;
   options.fps = args.number("fps");
   options.views.yaw_steps = static_cast<int>(args.integer("yaw-steps"));
-  options.views.heights_m = parse_float_list(args.get("heights"), "heights");
+  for (const double height : args.numbers("heights"))
+    options.views.heights_m.push_back(static_cast<float>(height));
   options.views.distance_m = static_cast<float>(args.number("distance"));
   if (!posedb::parse_scaling(args.get("scaling"), options.scaling)) {
     throw InputError("--scaling",
@@ -124,13 +115,17 @@ int build(int argc, char** argv) {
     throw InputError("--body", "expected canonical or source, got '" + args.get("body") + "'");
   options.clusters = static_cast<int>(args.integer("clusters"));
   options.seed = static_cast<std::uint64_t>(args.integer("seed"));
-  options.threads = static_cast<int>(std::clamp(args.integer("threads"), 1L, 64L));
+  options.threads = static_cast<int>(args.integer("threads"));
   options.command = joined_command("build", argc, argv);
 
   const std::vector<std::string> files = args.has("split")
                                              ? files_of_split(args.positionals(), args.get("split"))
                                              : posedb::collect_motion_files(args.positionals());
   if (files.empty()) throw InputError("", "no .bvh or .amc files in the given paths");
+  std::vector<NamedPath> inputs;
+  for (const std::string& file : files) inputs.push_back({"", file});
+  for (const std::string& path : args.positionals()) inputs.push_back({"PATH", path});
+  refuse_output_over_inputs({"--out", args.get("out")}, inputs);
   std::cerr << "building from " << files.size() << " motion file(s)\n";
 
   posedb::BuildReport report;
@@ -200,7 +195,7 @@ int info(int argc, char** argv) {
   const posedb::Database db = posedb::Database::open(args.positionals()[0]);
   json j = info_json(db);
   if (args.has("json")) {
-    std::cout << j.dump(2) << "\n";
+    std::cout << json_text(j, 2) << "\n";
     return 0;
   }
   const auto& b = db.build_info();
@@ -298,13 +293,15 @@ int query(int argc, char** argv) {
   args.positional("FILE", "pose database")
       .option("pose", "JSON", "the pose, inline")
       .option("pose-file", "FILE", "the pose, from a file")
-      .option("self", "N", "query with the database's own projection number N")
-      .option("k", "N", "neighbours to return", "10")
+      .option("self", "N", "query with the database's own projection number N", std::nullopt,
+              Range::count(0, std::numeric_limits<long>::max()))
+      .option("k", "N", "neighbours to return", "10", Range::count(1, 10000))
       .option("method", "NAME",
               "clusters (the database's own index), exact, or flann (kd-forest built now)",
               "clusters")
-      .option("probe", "N", "clusters to scan (method clusters)", "16")
-      .option("checks", "N", "leaves to examine (method flann)", "128")
+      .option("probe", "N", "clusters to scan (method clusters)", "16", Range::count(1, 1'000'000))
+      .option("checks", "N", "leaves to examine (method flann)", "128",
+              Range::count(1, 100'000'000))
       .flag("json", "print JSON lines");
   int code = 0;
   if (!args.parse(argc, argv, code)) return code;
@@ -363,22 +360,22 @@ int query(int argc, char** argv) {
   }
   std::vector<posedb::Neighbor> found;
   index->search(query.data(), index->supports_weights() ? weights.data() : nullptr,
-                static_cast<int>(std::clamp(args.integer("k"), 1L, 10000L)), found);
+                static_cast<int>(args.integer("k")), found);
   for (size_t r = 0; r < found.size(); ++r) {
     const auto& rec = db.projection_records()[found[r].index];
     const auto& frame = db.frames()[rec.frame];
     const auto& clip = db.clips()[frame.clip];
     const auto& view = db.views()[rec.view];
     if (args.has("json")) {
-      std::cout << json{{"rank", r},
-                        {"projection", found[r].index},
-                        {"distance", found[r].distance},
-                        {"clip", clip.name},
-                        {"clip_frame", frame.clip_frame},
-                        {"frame", rec.frame},
-                        {"yaw_deg", view.yaw_deg},
-                        {"camera_height_m", view.height_m}}
-                       .dump()
+      std::cout << json_text(json{{"rank", r},
+                                  {"projection", found[r].index},
+                                  {"distance", found[r].distance},
+                                  {"clip", clip.name},
+                                  {"clip_frame", frame.clip_frame},
+                                  {"frame", rec.frame},
+                                  {"yaw_deg", view.yaw_deg},
+                                  {"camera_height_m", view.height_m}},
+                             -1)
                 << "\n";
     } else {
       std::cout << std::setw(3) << r << "  distance " << std::setw(10) << std::setprecision(6)

@@ -18,8 +18,10 @@
 #include "core/input_error.hpp"
 #include "eval/virtual_protocol.hpp"
 #include "eval_configs.hpp"
+#include "eval_leaks.hpp"
 #include "eval_report.hpp"
 #include "motion/canonical_body.hpp"
+#include "output_files.hpp"
 #include "posedb/builder.hpp"
 #include "posedb/database.hpp"
 #include "progress_bar.hpp"
@@ -189,16 +191,27 @@ int virtual_protocol(int argc, char** argv) {
               "the paper's yaw-only 1.5 m database (built from the train split when absent)")
       .option("mocap", "DIR", "cmu31 folder with splits.txt", "../shared/data/mocap/cmu31")
       .option("json", "FILE", "where to write all numbers", "eval_virtual.json")
-      .option("threads", "N", "worker threads", "2")
-      .option("clips", "N", "use only the first N held-out clips (0 = all)", "0")
+      .option("threads", "N", "worker threads", "2", Range::count(1, 64))
+      .option("clips", "N", "use only the first N held-out clips (0 = all)", "0",
+              Range::count(0, 1'000'000))
       .option("input-layout", "FILE",
               "render the 2D input in this layout's keypoint definition (calibration/layouts/"
               "*.yaml;\nthe truth stays canonical) and run every configuration as is, \"+ 2D "
               "offsets\" and\n\"+ candidate offsets\" (docs/keypoint-layouts.md)")
-      .flag("quick", "2 yaws per camera family and 2 noise levels");
+      .flag("quick", "2 yaws per camera family and 2 noise levels")
+      .flag("allow-leak",
+            "evaluate even when a database holds held-out CMU subjects' clips (refused "
+            "otherwise); the results then say so, loudly");
   int code = 0;
   if (!args.parse(argc, argv, code)) return code;
   if (!args.has("db")) throw InputError("--db", "required: a database built from the train split");
+  std::vector<NamedPath> inputs;
+  for (const std::string& given : args.all("db"))
+    inputs.push_back(
+        {"--db", given.substr(given.find('=') == std::string::npos ? 0 : given.find('=') + 1)});
+  inputs.push_back({"--paper-db", args.get("paper-db")});
+  inputs.push_back({"--input-layout", args.get("input-layout")});
+  refuse_output_over_inputs({"--json", args.get("json")}, inputs);
   const auto started = std::chrono::steady_clock::now();
   std::vector<std::string> labels;
   std::vector<posedb::Database> databases;
@@ -213,6 +226,13 @@ int virtual_protocol(int argc, char** argv) {
   }
   const posedb::Database& full = databases.front();
   const std::string mocap = args.get("mocap");
+  LeakCheck leaks;
+  for (const posedb::Database& db : databases) leaks.add(db.path(), cmu_heldout_clips(db, mocap));
+  if (args.has("paper-db")) {
+    leaks.add(args.get("paper-db"),
+              cmu_heldout_clips(posedb::Database::open(args.get("paper-db")), mocap));
+  }
+  leaks.enforce(args.has("allow-leak"), "the held-out CMU subjects", "mocap eval virtual");
   const posedb::Database paper =
       open_paper_database(args.get("paper-db"), mocap, "mocap eval virtual");
 
@@ -235,7 +255,7 @@ int virtual_protocol(int argc, char** argv) {
   ProgressBar bar;
   const auto summed =
       run_jobs(configs, cameras, conditions, truth, bones, input_layout ? &*input_layout : nullptr,
-               static_cast<int>(std::clamp(args.integer("threads"), 1L, 64L)), bar);
+               static_cast<int>(args.integer("threads")), bar);
   bar.finish();
   auto at = [&](std::size_t c, std::size_t k, std::size_t n) -> const eval::Scores& {
     return summed[(c * cameras.size() + k) * conditions.size() + n];
@@ -250,10 +270,11 @@ int virtual_protocol(int argc, char** argv) {
               {"paper_database", json::parse(paper.options_json())},
               {"input_layout", input_layout ? input_layout->source : "canonical joints"},
               {"clips", truth.size()},
-              {"frames", frames}};
-  std::cout << "## Virtual protocol: " << truth.size() << " held-out clips, " << frames
-            << " frames at " << full.build_info().fps << " fps, " << cameras.size()
-            << " cameras\n\n"
+              {"frames", frames},
+              {"leak", leaks.to_json()}};
+  std::cout << leaks.markdown_warning() << "## Virtual protocol: " << truth.size()
+            << " held-out clips, " << frames << " frames at " << full.build_info().fps << " fps, "
+            << cameras.size() << " cameras\n\n"
             << "| configuration | condition | MPJPE mm | PA-MPJPE mm | accel err mm/f² | jitter "
                "mm/f² | coverage |\n"
             << "|---|---|---:|---:|---:|---:|---:|\n";

@@ -9,6 +9,8 @@
 #include <memory>
 #include <thread>
 
+#include "output_files.hpp"
+
 namespace mocap::cli {
 
 nlohmann::json machine_description() {
@@ -46,7 +48,7 @@ void write_results(nlohmann::json& results, const std::string& path,
                    std::chrono::steady_clock::time_point started) {
   results["seconds"] =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-  std::ofstream(path) << results.dump(2) << "\n";
+  write_file_atomically(path, json_text(results, 2) + "\n");
   std::cout << "\nAll numbers: " << path << "\n";
 }
 

@@ -10,6 +10,7 @@
 #include "core/input_error.hpp"
 #include "export/gltf_writer.hpp"
 #include "motion/bvh.hpp"
+#include "output_files.hpp"
 
 namespace mocap::cli {
 
@@ -26,17 +27,17 @@ int export_command(int argc, char** argv) {
       "as BVH already is. docs/export.md says how to open it in Blender, Unity and three.js.");
   args.positional("IN.bvh", "the motion(s) to export", true)
       .option("gltf", "OUT.glb", "the glTF binary to write (through a temporary file)")
-      .option("scale", "auto|S", "metres per BVH unit", "auto")
+      .option("scale", "auto|S", "metres per BVH unit", "auto", Range::positive().or_word("auto"))
       .flag("no-mesh", "joints, skin and animation only, no stick-figure mesh");
   int code = 0;
   if (!args.parse(argc, argv, code)) return code;
   if (!args.has("gltf")) throw InputError("mocap export", "--gltf OUT.glb is required");
 
   float scale = 0.0f;
-  if (const std::string s = args.get("scale"); s != "auto") {
-    scale = static_cast<float>(args.number("scale"));
-    if (!(scale > 0.0f)) throw InputError("mocap export", "--scale must be positive");
-  }
+  if (args.get("scale") != "auto") scale = static_cast<float>(args.number("scale"));
+  std::vector<NamedPath> inputs;
+  for (const std::string& path : args.positionals()) inputs.push_back({"IN.bvh", path});
+  refuse_output_over_inputs({"--gltf", args.get("gltf")}, inputs);
   std::vector<motion::Clip> clips;
   for (const std::string& path : args.positionals()) {
     clips.push_back(motion::read_bvh(path));

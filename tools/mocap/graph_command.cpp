@@ -34,7 +34,14 @@ int inspect(const std::vector<std::string>& operands) {
   const Registry& registry = Registry::instance();
   if (operands.size() == 1) {
     const NodeType* type = registry.find(operands[0]);
-    if (!type) throw InputError("mocap graph inspect", "unknown node type '" + operands[0] + "'");
+    if (!type) {
+      std::vector<std::string> known;
+      for (const NodeType* t : registry.all()) known.push_back(t->name);
+      const std::string near = nearest(operands[0], known);
+      throw InputError("mocap graph inspect",
+                       "unknown node type '" + operands[0] + "'" +
+                           (near.empty() ? "" : "; did you mean '" + near + "'?"));
+    }
     std::cout << describe(*type);
     return 0;
   }

@@ -20,8 +20,10 @@
 #include "core/input_error.hpp"
 #include "eval/humaneva_protocol.hpp"
 #include "eval_configs.hpp"
+#include "eval_leaks.hpp"
 #include "eval_report.hpp"
 #include "motion/canonical_body.hpp"
+#include "output_files.hpp"
 #include "posedb/parallel_chunks.hpp"
 #include "progress_bar.hpp"
 #include "recon/layout_offsets.hpp"
@@ -341,7 +343,7 @@ int humaneva_eval_command(int argc, char** argv) {
       .option("data", "DIR", "HumanEva-I in the VideoPose3D format",
               "../shared/data/eval/humaneva_i_videopose3d")
       .option("json", "FILE", "where to write all numbers", "eval_humaneva.json")
-      .option("threads", "N", "worker threads", "2")
+      .option("threads", "N", "worker threads", "2", Range::count(1, 64))
       .option("configs", "NAMES",
               "comma-separated configurations to run (e.g. 'per-frame NN,full: path + SG + ray + "
               "view'; all when absent)")
@@ -362,12 +364,33 @@ int humaneva_eval_command(int argc, char** argv) {
               "built from it)",
               "validate")
       .flag("no-humaneva-db", "skip the databases built from HumanEva Train")
-      .flag("quick", "2 noise levels instead of 5");
+      .flag("quick", "2 noise levels instead of 5")
+      .flag("allow-leak",
+            "evaluate even when a database holds clips of the evaluated HumanEva split "
+            "(refused otherwise); the results then say so, loudly");
   int code = 0;
   if (!args.parse(argc, argv, code)) return code;
   if (!args.has("db")) throw InputError("--db", "required: a database built from the train split");
+  refuse_output_over_inputs({"--json", args.get("json")},
+                            {{"--db", args.get("db")},
+                             {"--paper-db", args.get("paper-db")},
+                             {"--humaneva-db", args.get("humaneva-db")}});
   const auto started = std::chrono::steady_clock::now();
-  const int threads = static_cast<int>(std::clamp(args.integer("threads"), 1L, 64L));
+  const int threads = static_cast<int>(args.integer("threads"));
+  // The databases are checked for the evaluated motion before anything is loaded.
+  const bool on_train = args.get("evaluate-on") == "train";
+  if (!on_train && args.get("evaluate-on") != "validate")
+    throw InputError("--evaluate-on", "validate or train");
+  if (on_train && !args.has("no-humaneva-db"))
+    throw InputError("--evaluate-on", "train needs --no-humaneva-db (those databases are Train)");
+  const std::string evaluated_split = on_train ? "Train" : "Validate";
+  LeakCheck leaks;
+  for (const std::string option : {"db", "paper-db", "humaneva-db"}) {
+    if (args.has(option) && (option != "humaneva-db" || !args.has("no-humaneva-db")))
+      leaks.add(args.get(option),
+                humaneva_clips(posedb::Database::open(args.get(option)), evaluated_split));
+  }
+  leaks.enforce(args.has("allow-leak"), "HumanEva-I " + evaluated_split, "mocap eval humaneva");
   const std::string folder = args.get("data");
   const he::Dataset data = he::load_dataset(folder);
   const auto cameras = he::load_cameras(std::filesystem::path(folder) / he::kCamerasFile);
@@ -382,11 +405,7 @@ int humaneva_eval_command(int argc, char** argv) {
     return wanted.empty() || std::find(wanted.begin(), wanted.end(), name) != wanted.end();
   };
   const bool with_paper = selected("paper");
-  const bool on_train = args.get("evaluate-on") == "train";
-  if (!on_train && args.get("evaluate-on") != "validate")
-    throw InputError("--evaluate-on", "validate or train");
-  if (on_train && !args.has("no-humaneva-db"))
-    throw InputError("--evaluate-on", "train needs --no-humaneva-db (those databases are Train)");
+
   const std::string offsets_setting = args.get("layout-offsets");
   const bool compare = offsets_setting.starts_with("compare");
   const std::string offsets_file = offsets_setting.starts_with("compare:")
@@ -468,7 +487,9 @@ int humaneva_eval_command(int argc, char** argv) {
               {"joints", kJointNote},
               {"joint_correspondence", eval::humaneva_joint_correspondence()},
               {"validation", sequences_json(sequences)}};
-  out["evaluated_split"] = on_train ? "Train" : "Validate";
+  out["evaluated_split"] = evaluated_split;
+  out["leak"] = leaks.to_json();
+  std::cout << leaks.markdown_warning();
   if (offsets) out["layout_offsets"] = offsets->source;
   if (proportions)
     for (const auto& [subject, p] : *proportions)

@@ -20,11 +20,13 @@
 #include "core/input_error.hpp"
 #include "eval/humaneva_protocol.hpp"
 #include "eval_configs.hpp"
+#include "eval_leaks.hpp"
 #include "eval_report.hpp"
 #include "fit/fit_evaluation.hpp"
 #include "fit/foot_contact.hpp"
 #include "fit/view_fit.hpp"
 #include "fit_cameras.hpp"
+#include "output_files.hpp"
 #include "posedb/parallel_chunks.hpp"
 #include "progress_bar.hpp"
 
@@ -86,22 +88,32 @@ int humaneva_fit_command(int argc, char** argv) {
       .option("data", "DIR", "HumanEva-I in the VideoPose3D format",
               "../shared/data/eval/humaneva_i_videopose3d")
       .option("json", "FILE", "where to write all numbers", "eval_humaneva_fit.json")
-      .option("threads", "N", "worker threads", "2")
-      .option("max-frames", "N", "frames per chunk at most, at the database rate (0 = all)", "0")
-      .option("noise", "F", "2D Gaussian noise, fraction of the 2D box height", "0")
-      .option("lag", "N", "live fit: frames of delay", "3")
-      .option("clearance", "M", "ankle height over the floor the ground term keeps", "0.07")
+      .option("threads", "N", "worker threads", "2", Range::count(1, 64))
+      .option("max-frames", "N", "frames per chunk at most, at the database rate (0 = all)", "0",
+              Range::count(0, std::numeric_limits<int>::max()))
+      .option("noise", "F", "2D Gaussian noise, fraction of the 2D box height", "0",
+              Range::between(0.0, 1.0))
+      .option("lag", "N", "live fit: frames of delay", "3", Range::count(0, 100))
+      .option("clearance", "M", "ankle height over the floor the ground term keeps", "0.07",
+              Range::between(0.0, 0.5))
       .flag("no-ground", "no ground plane (default: HumanEva's floor, world Z = 0)")
-      .flag("quick", "the first 48 frames (2 s) of every chunk");
+      .flag("quick", "the first 48 frames (2 s) of every chunk")
+      .flag("allow-leak",
+            "evaluate even when the database holds HumanEva Validate clips (refused otherwise); "
+            "the results then say so, loudly");
   int code = 0;
   if (!args.parse(argc, argv, code)) return code;
   if (!args.has("db")) throw InputError("--db", "required: a pose database");
+  refuse_output_over_inputs({"--json", args.get("json")}, {{"--db", args.get("db")}});
   const auto started = std::chrono::steady_clock::now();
-  const int threads = static_cast<int>(std::clamp(args.integer("threads"), 1L, 64L));
+  const int threads = static_cast<int>(args.integer("threads"));
+  const posedb::Database db = posedb::Database::open(args.get("db"));
+  LeakCheck leaks;
+  leaks.add(db.path(), humaneva_clips(db, "Validate"));
+  leaks.enforce(args.has("allow-leak"), "HumanEva-I Validate", "mocap eval humaneva-fit");
   const std::string folder = args.get("data");
   const he::Dataset data = he::load_dataset(folder);
   const auto cameras = he::load_cameras(std::filesystem::path(folder) / he::kCamerasFile);
-  const posedb::Database db = posedb::Database::open(args.get("db"));
   const double fps = db.build_info().fps;
   auto sequences = eval::humaneva_validation_sequences(data, cameras, fps);
   long max_frames = args.integer("max-frames");
@@ -170,7 +182,8 @@ int humaneva_fit_command(int argc, char** argv) {
   for (const auto& a : eval::kHumanEvaActions) actions.emplace_back(a.label);
   actions.emplace_back("all");
 
-  std::cout << "## HumanEva-I Validate with its cameras, before and after fitting\n\n"
+  std::cout << leaks.markdown_warning()
+            << "## HumanEva-I Validate with its cameras, before and after fitting\n\n"
             << sequences.size() << " sequences (chunk x camera), " << frames << " frames at " << fps
             << " fps; database " << args.get("db") << "; noise " << condition.label()
             << "; live lag " << fit_options.lag << "; ground plane "
@@ -211,6 +224,7 @@ int humaneva_fit_command(int argc, char** argv) {
               {"frames", frames},
               {"note", note},
               {"joint_correspondence", eval::humaneva_joint_correspondence()},
+              {"leak", leaks.to_json()},
               {"results", table}};
   write_results(out, args.get("json"), started);
   return 0;

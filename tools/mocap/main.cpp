@@ -15,7 +15,8 @@ struct Command {
 };
 
 constexpr Command kCommands[] = {
-    {"reconstruct", "3D motion of every person from a folder of OpenPose JSON",
+    {"reconstruct",
+     "3D motion of every person in a video, camera, stream, image folder or OpenPose JSON",
      mocap::cli::reconstruct_command},
     {"db", "build, inspect and query the 2D-projection pose database", mocap::cli::db_command},
     {"run", "run a graph file (nodes wired by YAML), in one or several processes",

@@ -2,6 +2,13 @@
 // JSON (graphs/monocular_json.yaml) or on a video, camera, stream or image folder
 // (graphs/monocular_video.yaml: MoveNet finds the people) and writes poses.jsonl, one BVH per
 // person, overlay.mp4 and summary.json.
+//
+// It never damages what it did not write: everything it can check (options, input, database,
+// camera file, graph, ports) is checked before it touches DIR; a DIR holding an earlier run's
+// output is refused unless --force, which removes that output first (reconstruct_outputs.hpp);
+// the sinks create their files when their first frame arrives and write them in place as the run
+// goes, so a killed run keeps them under their own names; summary.json is written last, through a
+// temporary file, and lists the files of this run.
 
 #include <unistd.h>
 
@@ -13,6 +20,7 @@
 #include <iostream>
 #include <map>
 #include <sstream>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -24,13 +32,17 @@
 #include "core/keypoint_layout.hpp"
 #include "core/messages.hpp"
 #include "detect/model_files.hpp"
+#include "detector_presets.hpp"
 #include "eval_report.hpp"
 #include "graph/graph_spec.hpp"
 #include "graph/plugins.hpp"
 #include "graph/validation.hpp"
 #include "graph_runner.hpp"
 #include "io/openpose_json.hpp"
+#include "output_files.hpp"
+#include "posedb/database.hpp"
 #include "progress_bar.hpp"
+#include "reconstruct_outputs.hpp"
 #include "video/video_source.hpp"
 
 namespace mocap::cli {
@@ -74,6 +86,12 @@ InputKind input_kind(const std::string& input) {
   return InputKind::video;
 }
 
+std::string number(double value) {
+  std::ostringstream out;
+  out << value;
+  return out.str();
+}
+
 // The video's geometry and rate, read by opening it (closed again before the graph opens it).
 struct VideoInfo {
   int width = 0, height = 0;
@@ -84,24 +102,58 @@ struct VideoInfo {
 
 VideoInfo probe_video(const Args& args) {
   video::SourceOptions options;
-  if (args.has("fps")) options.folder_fps = std::stod(args.get("fps"));
+  if (args.has("fps")) options.folder_fps = options.fps = args.number("fps");
   const video::VideoSource source(args.positionals()[0], options);
-  return {source.width(), source.height(), source.fps(), source.frame_count(), source.live()};
+  VideoInfo info{source.width(), source.height(), source.fps(), source.frame_count(),
+                 source.live()};
+  // A video file or stream has its own rate, which stamps poses.jsonl's times: another --fps would
+  // make the BVH and the overlay disagree with them. Image folders and cameras take --fps.
+  const bool own_rate =
+      source.kind() == video::SourceKind::file || source.kind() == video::SourceKind::network;
+  if (args.has("fps") && own_rate && info.fps > 0 &&
+      std::abs(args.number("fps") - info.fps) > 1e-3 * info.fps) {
+    throw InputError("--fps", "the video " + args.positionals()[0] + " runs at " +
+                                  number(info.fps) +
+                                  " frames/s, its own rate, which times "
+                                  "every output; --fps " +
+                                  args.get("fps") +
+                                  " is for image folders, cameras and OpenPose JSON: leave it out "
+                                  "(or resample the video, e.g. ffmpeg -i IN -r " +
+                                  args.get("fps") + " OUT)");
+  }
+  return info;
 }
 
-std::string number(double value) {
-  std::ostringstream out;
-  out << value;
-  return out.str();
+// A file or image folder is read a second time by the overlay, by frame number as the 3D of each
+// frame arrives (its video_path), instead of through an edge from the source: no decoded frame
+// waits in the overlay for its 3D (a full fit sends it a window later), and the overlay never
+// holds the source up. Cameras and streams cannot be read twice and keep the edge.
+void read_frames_in_overlay(graph::GraphSpec& spec, const std::string& input) {
+  set_param(spec, "sink.overlay", "video_path", input);
+  std::erase_if(spec.edges, [&](const graph::EdgeSpec& edge) {
+    const graph::NodeSpec* to = spec.find_node(edge.to.node);
+    return to && to->type == "sink.overlay" && edge.to.port == "video";
+  });
 }
 
 void configure_video(graph::GraphSpec& spec, const Args& args, const VideoInfo& info) {
   set_param(spec, "source.video", "path", args.positionals()[0]);
   set_param(spec, "source.video", "decoder_threads", args.get("decoder-threads"));
   if (args.has("fps")) set_param(spec, "source.video", "fps", args.get("fps"));
-  set_param(spec, "detect.movenet", "input_size", args.get("detector-size"));
-  set_param(spec, "detect.movenet", "threads", args.get("detector-threads"));
-  const double fps = args.has("fps") ? std::stod(args.get("fps")) : info.fps > 0 ? info.fps : 30.0;
+  if (args.has("detector-size")) {
+    const bool multipose = std::any_of(spec.nodes.begin(), spec.nodes.end(),
+                                       [](const auto& n) { return n.type == "detect.movenet"; });
+    if (!multipose)
+      throw InputError("--detector-size",
+                       "sets the input size of the multipose detectors only; "
+                       "add --detector multipose");
+    set_param(spec, "detect.movenet", "input_size", args.get("detector-size"));
+  }
+  for (const auto& preset : detector_presets()) {
+    set_param(spec, preset.type, "threads", args.get("detector-threads"));
+    set_param(spec, preset.type, "backend", args.get("detector-backend"));
+  }
+  const double fps = info.fps > 0 ? info.fps : args.has("fps") ? args.number("fps") : 30.0;
   for (const char* type : {"sink.bvh", "sink.overlay"}) set_param(spec, type, "fps", number(fps));
   const std::string width = std::to_string(info.width), height = std::to_string(info.height);
   for (const char* type : {"recon.temporal_selector", "recon.fit"}) {
@@ -111,15 +163,48 @@ void configure_video(graph::GraphSpec& spec, const Args& args, const VideoInfo& 
   }
   set_param(spec, "sink.overlay", "canvas_width", width);
   set_param(spec, "sink.overlay", "canvas_height", height);
+  if (!info.live) read_frames_in_overlay(spec, args.positionals()[0]);
 }
 
-// A graph with a MoveNet node on the cached model: a missing model is reported before anything
+bool is_detector(const std::string& type) {
+  for (const auto& preset : detector_presets())
+    if (preset.type == type) return true;
+  return false;
+}
+
+// Puts the named strategy in place of the graph's detector node (same name, same edges).
+void choose_detector(graph::GraphSpec& spec, const std::string& name) {
+  const DetectorPreset& preset = detector_preset(name);
+  bool found = false;
+  for (auto& node : spec.nodes) {
+    if (!is_detector(node.type)) continue;
+    node.type = preset.type;
+    node.params.clear();
+    for (const auto& [key, value] : preset.params)
+      node.params[key] = {value, {"mocap reconstruct --detector", 0}};
+    found = true;
+  }
+  if (!found) throw InputError("--detector", "the graph has no detector node to replace");
+}
+
+// A graph with detector nodes on the cached models: a missing model is reported before anything
 // runs, naming the command that fetches it.
 void check_detector_model(const graph::GraphSpec& spec) {
+  const auto given = [](const graph::NodeSpec& node, const char* key) {
+    const auto it = node.params.find(key);
+    return it != node.params.end() && !it->second.text.empty();
+  };
   for (const auto& node : spec.nodes) {
-    if (node.type != "detect.movenet") continue;
-    const auto model = node.params.find("model");
-    if (model == node.params.end() || model->second.text.empty()) detect::movenet_model_json();
+    if (node.type == "detect.movenet" || node.type == "detect.tiles") {
+      if (!given(node, "model")) detect::movenet_model_json();
+    } else if (node.type == "detect.topdown") {
+      if (!given(node, "box_model_file")) detect::cached_model_json("centernet");
+      if (!given(node, "pose_model_file")) {
+        const auto it = node.params.find("pose_model");
+        const bool thunder = it != node.params.end() && it->second.text == "thunder";
+        detect::cached_model_json(thunder ? "movenet-thunder" : "movenet-lightning");
+      }
+    }
   }
 }
 
@@ -138,8 +223,8 @@ std::string matcher_layout_offsets(const std::string& setting, const std::string
   return std::string(layout(first.layout).name);
 }
 
-// What --fit means: auto fits the whole sequence of a file (offline), with a fixed lag for a live
-// source, and not at all for keypoints whose camera is unknown (JSON without --image-size or
+// What --fit means: auto fits a file offline (full: overlapping windows), a live source with a
+// fixed lag, and not at all keypoints whose camera is unknown (JSON without --image-size or
 // --camera: nothing tells where the camera's rays go).
 std::string fit_mode(const Args& args, InputKind kind, bool live) {
   const std::string fit = args.get("fit");
@@ -173,16 +258,10 @@ void configure(graph::GraphSpec& spec, const Args& args, const fs::path& out, In
   set_param(spec, "recon.matcher", "layout_offsets",
             matcher_layout_offsets(args.get("layout-offsets"), args.positionals()[0], kind));
   if (args.has("image-size")) {
-    const std::string size = args.get("image-size");
-    const auto x = size.find('x');
-    if (x == std::string::npos || x == 0 || x + 1 == size.size() ||
-        size.find_first_not_of("0123456789x") != std::string::npos) {
-      throw InputError("--image-size",
-                       "expected WIDTHxHEIGHT in pixels, e.g. 1920x1080, got '" + size + "'");
-    }
+    const ImageSize size = args.image_size("image-size");
     for (const char* type : {"recon.temporal_selector", "recon.fit"}) {
-      set_param(spec, type, "image_width", size.substr(0, x));
-      set_param(spec, type, "image_height", size.substr(x + 1));
+      set_param(spec, type, "image_width", std::to_string(size.width));
+      set_param(spec, type, "image_height", std::to_string(size.height));
       set_param(spec, type, "hfov_deg", args.get("hfov"));
     }
   }
@@ -200,12 +279,48 @@ void configure(graph::GraphSpec& spec, const Args& args, const fs::path& out, In
   set_param(spec, "sink.overlay", "png_dir", out.string());
 }
 
-// What the run produced, read back from poses.jsonl: frames, people, track lengths.
+// The keypoints of an OpenPose folder must lie in the image the size says (`option` names it):
+// a smaller size would put every ray and the fit's camera wrong. Files that cannot be read are
+// left to the source, which reports them.
+void check_keypoints_inside(const std::string& folder, int width, int height,
+                            const std::string& option) {
+  float max_x = 0.0f, max_y = 0.0f;
+  fs::path at_x, at_y;
+  for (const auto& e : fs::directory_iterator(folder)) {
+    if (!e.path().filename().string().ends_with("_keypoints.json")) continue;
+    People2D people;
+    try {
+      people = io::read_openpose_file(e.path());
+    } catch (const std::exception&) {
+      continue;
+    }
+    for (const Person2D& p : people.people) {
+      for (const Keypoint2D& k : p.joints) {
+        if (!(k.confidence > 0.0f) || !std::isfinite(k.x) || !std::isfinite(k.y)) continue;
+        if (k.x > max_x) max_x = k.x, at_x = e.path();
+        if (k.y > max_y) max_y = k.y, at_y = e.path();
+      }
+    }
+  }
+  // Keypoints may sit on the last pixel's far edge: a pixel of slack.
+  if (max_x > static_cast<float>(width) + 1.0f || max_y > static_cast<float>(height) + 1.0f) {
+    const bool x = max_x > static_cast<float>(width) + 1.0f;
+    throw InputError(option, std::to_string(width) + "x" + std::to_string(height) +
+                                 " is smaller than the keypoints: " + (x ? "x" : "y") +
+                                 " reaches " + number(x ? max_x : max_y) + " in " +
+                                 (x ? at_x : at_y).string() +
+                                 "; give the size of the images the keypoints came from");
+  }
+}
+
+// What the run produced, read back from poses.jsonl: frames, people, track lengths. Only whole
+// lines count: a last line without its newline was cut by a kill.
 json summarize_output(const fs::path& jsonl) {
-  std::ifstream in(jsonl);
+  std::ifstream in(jsonl, std::ios::binary);
   std::map<int, int> frames_per_id;
   std::size_t frames = 0, person_frames = 0, placed = 0;
   for (std::string line; std::getline(in, line);) {
+    if (in.eof()) break;  // no newline after it
     const json j = json::parse(line, nullptr, false);
     if (j.is_discarded()) continue;
     ++frames;
@@ -224,6 +339,88 @@ json summarize_output(const fs::path& jsonl) {
           {"tracks_longer_than_50_frames", long_tracks}};
 }
 
+// The database and camera file are read now, before DIR is touched: a missing, damaged (checksums)
+// or foreign file ends the command with nothing written.
+void check_database_and_camera(const Args& args) {
+  const std::string db = args.get("db");
+  if (!fs::exists(db)) {
+    throw InputError(db,
+                     "no pose database here: build one with 'mocap db build "
+                     "../shared/data/mocap/cmu31 --split train --out " +
+                         db + "'");
+  }
+  (void)posedb::Database::open(db);
+  if (args.has("camera")) (void)camera::read_camera_file(args.get("camera"));
+}
+
+// No output may be an input: DIR is not the input, and none of the files written into it is the
+// input, the database, the camera file or the graph.
+void refuse_outputs_over_inputs(const Args& args, const fs::path& out,
+                                const std::string& graph_file) {
+  const std::vector<NamedPath> inputs = {{"INPUT", args.positionals()[0]},
+                                         {"--db", args.get("db")},
+                                         {"--camera", args.get("camera")},
+                                         {"--graph", graph_file}};
+  refuse_output_over_inputs({"--out", out.string()}, {inputs[0]});
+  for (const char* name : {"poses.jsonl", "summary.json", "overlay.mp4"})
+    refuse_output_over_inputs({"--out", (out / name).string()}, inputs);
+}
+
+json files_json(const std::vector<fs::path>& files) {
+  json list = json::array();
+  for (const fs::path& file : files) {
+    std::error_code ec;
+    const auto bytes = fs::file_size(file, ec);
+    list.push_back({{"path", file.string()}, {"bytes", ec ? 0 : bytes}});
+  }
+  return list;
+}
+
+// "wrote ..." lines for the files of this run (all the outputs in DIR: see
+// reconstruct_outputs.hpp).
+void print_written(const fs::path& out, const WrittenOutputs& written, const json& summary,
+                   double frames_per_second) {
+  for (const fs::path& file : written.poses) {
+    std::cout << "wrote " << file.string() << ": " << summary["frames"] << " frames, "
+              << summary["people"] << " people (" << summary["tracks_longer_than_50_frames"]
+              << " tracks longer than 50 frames), " << std::fixed << std::setprecision(1)
+              << frames_per_second << " frames/s\n";
+  }
+  if (written.bvh.size() > 8) {
+    std::cout << "wrote " << written.bvh.size()
+              << " BVH files, one per person: " << (out / "person_<id>.bvh").string() << " (ids";
+    for (std::size_t i = 0; i < written.bvh_ids.size(); ++i)
+      std::cout << (i ? ", " : " ") << written.bvh_ids[i];
+    std::cout << ")\n";
+  } else {
+    for (const fs::path& file : written.bvh) std::cout << "wrote " << file.string() << "\n";
+  }
+  for (const fs::path& file : written.videos) std::cout << "wrote " << file.string() << "\n";
+  if (written.images.size() > 2) {
+    std::cout << "wrote " << written.images.size()
+              << " overlay images: " << (out / "overlay_<frame>.png").string() << "\n";
+  } else {
+    for (const fs::path& file : written.images) std::cout << "wrote " << file.string() << "\n";
+  }
+}
+
+// For a run that did not complete but wrote something: what it kept, and what it did not write.
+std::string incomplete_note(const WrittenOutputs& written, const json& summary,
+                            std::int64_t input_frames) {
+  std::ostringstream note;
+  note << "kept what it wrote before it ended (the files above, each whole): poses.jsonl holds "
+       << summary["frames"].get<std::size_t>() << " frames";
+  if (input_frames > 0) note << " of the " << input_frames << " the input announced";
+  std::vector<std::string> missing;
+  if (written.poses.empty()) missing.push_back("poses.jsonl");
+  if (written.bvh.empty()) missing.push_back("any person_<id>.bvh");
+  if (written.videos.empty()) missing.push_back("overlay.mp4");
+  for (std::size_t i = 0; i < missing.size(); ++i)
+    note << (i ? ", " : "; not written: ") << missing[i];
+  if (!written.partial.empty()) note << "; left incomplete: " << short_list(written.partial);
+  return note.str();
+}
+
 json node_latency(const graph::GraphStats& stats) {
   json nodes = json::object();
   for (const auto& n : stats.nodes) {
@@ -237,40 +434,69 @@ json node_latency(const graph::GraphStats& stats) {
 
 int reconstruct_command(int argc, char** argv) {
   Args args(
-      "mocap reconstruct INPUT --out DIR [--db DB] [options]",
+      "mocap reconstruct INPUT --out DIR [--db DB] [--force] [options]",
       "Reconstructs the 3D motion of every person in a video file, camera device (/dev/videoN),\n"
       "RTSP/HTTP stream or folder of images (people found by MoveNet), or in a folder of OpenPose\n"
       "*_keypoints.json files (BODY_25, BODY_25B, COCO-18). Writes into DIR: poses.jsonl (one "
       "line\n"
       "per input frame: 15 joints per person, metres, camera coordinates, root-relative, and\n"
-      "absolute under joints_abs once fitted), "
-      "person_<id>.bvh per person, overlay.mp4 (the input beside the 3D skeletons) and "
-      "summary.json.");
+      "absolute under joints_abs once fitted), person_<id>.bvh per person (root placed once\n"
+      "fitted), overlay.mp4 (the input beside the 3D skeletons) and summary.json (what was run\n"
+      "and the files it wrote).\n\n"
+      "DIR holding an earlier run's output (poses.jsonl, summary.json, person_*.bvh, overlay*) is\n"
+      "refused, naming what is there, unless --force: then those files (only those) are set aside\n"
+      "once the input, database, camera file and graph have been checked, removed when the run "
+      "has\n"
+      "written its output, put back as they were when it wrote none (it failed at the start).\n"
+      "Files are written as the run goes and stay whole, so an interrupted run (Ctrl-C, a kill)\n"
+      "keeps what it wrote under the files' own names; summary.json is written at the end.");
   args.positional("INPUT",
                   "video file, /dev/videoN, rtsp:// or http:// URL, image folder, or "
                   "folder of OpenPose *_keypoints.json files")
       .option("out", "DIR", "output folder (created)")
+      .flag("force", "replace an earlier run's output in DIR (see above)")
       .option("db", "FILE", "pose database", default_database())
       .option("fps", "N",
-              "frame rate (OpenPose JSON and image folders: 30 when absent; videos: their own)")
+              "frame rate of image folders and OpenPose JSON (30 when absent), and the rate asked "
+              "of a camera; every output uses it. A video file or stream has its own rate: "
+              "another --fps is refused",
+              std::nullopt, Range::between(0.1, 1000.0))
+      .option("detector", "NAME",
+              "video: how people are found: auto (" + std::string(kFileDetector) + " for files, " +
+                  std::string(kLiveDetector) +
+                  " for cameras and streams; docs/detection-strategies.md) or one of " +
+                  detector_names(),
+              "auto")
       .option("detector-size", "N",
-              "video: MoveNet input size, a multiple of 32 (256 fast, 384-512 for small people)",
-              "256")
-      .option("detector-threads", "N", "video: detector threads (0: OpenCV's default)", "0")
+              "video, multipose detectors: MoveNet input size, a multiple of 32 (256 fast, "
+              "384-512 for small people)",
+              std::nullopt, Range::count(128, 1024))
+      .option("detector-backend", "NAME",
+              "video: network runtime of the detector: auto (XNNPACK when built in, else "
+              "cv::dnn), xnnpack or opencv (docs/models.md)",
+              "auto")
+      .option("detector-threads", "N",
+              "video: detector network threads (0: XNNPACK 1, cv::dnn OpenCV's default)", "0",
+              Range::count(0, 64))
       .option("decoder-threads", "N",
-              "video: FFmpeg decoding threads (0: one per core; needs OpenCV >= 4.7)", "0")
+              "video: FFmpeg decoding threads (0: one per core; needs OpenCV >= 4.7)", "0",
+              Range::count(0, 64))
       .option("image-size", "WxH",
-              "OpenPose JSON: size of the images the keypoints came from; turns each pose onto "
-              "its camera ray (off when absent; videos: always on, their own size)")
-      .option("hfov", "DEG", "horizontal field of view assumed with --image-size", "60")
+              "OpenPose JSON: size of the images the keypoints came from (refused when smaller "
+              "than the keypoints); turns each pose onto its camera ray (off when absent; "
+              "videos: always on, their own size)",
+              std::nullopt, Range::image_size())
+      .option("hfov", "DEG", "horizontal field of view assumed with --image-size", "60",
+              Range::between(1.0, 179.0))
       .option("camera", "FILE",
               "calibrated camera: the OpenCV YAML of `mocap calibrate intrinsics` or any rig "
               "file of one camera (docs/cameras.md); its matrix and lens distortion replace "
               "--image-size/--hfov for the ray through each root")
       .option("fit", "auto|off|live|full",
               "skeleton fitting (root translation, the person's bones, feet on the floor): full "
-              "over the whole sequence, live with a 3-frame lag; auto: full for files, live for "
-              "cameras and streams, off for OpenPose JSON without --image-size/--camera",
+              "in windows of 64 frames per person overlapping by 16 (written as each window is "
+              "solved), live with a 3-frame lag; auto: full for files, live for cameras and "
+              "streams, off for OpenPose JSON without --image-size/--camera",
               "auto")
       .option("ground", "auto|feet|off",
               "the floor for the fitting: auto takes the camera file's (`mocap calibrate "
@@ -292,17 +518,26 @@ int reconstruct_command(int argc, char** argv) {
   int code = 0;
   if (!args.parse(argc, argv, code)) return code;
   if (!args.has("out")) throw InputError("--out", "required: the output folder");
-  if (!fs::exists(args.get("db"))) {
-    throw InputError(args.get("db"),
-                     "no pose database here: build one with 'mocap db build "
-                     "../shared/data/mocap/cmu31 --split train --out " +
-                         args.get("db") + "'");
-  }
-  const InputKind kind = input_kind(args.positionals()[0]);
-  const VideoInfo info = kind == InputKind::video ? probe_video(args) : VideoInfo{};
+  if (args.has("detector-size") && args.integer("detector-size") % 32 != 0)
+    throw InputError("--detector-size",
+                     "expected a multiple of 32, got " + args.get("detector-size"));
+  const std::string input = args.positionals()[0];
   const fs::path out = args.get("out");
-  fs::create_directories(out);
 
+  // Everything that can be checked before DIR is touched.
+  const InputKind kind = input_kind(input);
+  refuse_output_over_inputs({"--out", out.string()}, {{"INPUT", input}});
+  check_database_and_camera(args);
+  const VideoInfo info = kind == InputKind::video ? probe_video(args) : VideoInfo{};
+  if (kind == InputKind::openpose_json) {
+    if (args.has("camera")) {
+      const camera::Camera lens = camera::read_camera_file(args.get("camera"));
+      check_keypoints_inside(input, lens.width, lens.height, args.get("camera"));
+    } else if (args.has("image-size")) {
+      const ImageSize size = args.image_size("image-size");
+      check_keypoints_inside(input, size.width, size.height, "--image-size");
+    }
+  }
   graph::load_plugins_from_environment();
   const std::string graph_file =
       args.has("graph")
@@ -311,6 +546,14 @@ int reconstruct_command(int argc, char** argv) {
              (kind == InputKind::video ? "monocular_video.yaml" : "monocular_json.yaml"))
                 .string();
   graph::GraphSpec spec = graph::load_graph_file(graph_file);
+  if (kind == InputKind::video) {
+    // The default graph carries the file default; --graph keeps its own unless asked.
+    const std::string detector = args.get("detector");
+    if (detector != "auto")
+      choose_detector(spec, detector);
+    else if (info.live && !args.has("graph"))
+      choose_detector(spec, std::string(kLiveDetector));
+  }
   configure(spec, args, out, kind);
   if (kind == InputKind::video) configure_video(spec, args, info);
   const std::string fit = fit_mode(args, kind, info.live);
@@ -318,11 +561,20 @@ int reconstruct_command(int argc, char** argv) {
   set_param(spec, "recon.fit", "ground", args.get("ground"));
   graph::apply_overrides(spec, args.all("set"));
   check_detector_model(spec);
+  json detector_summary = json::object();
+  for (const auto& node : spec.nodes) {
+    if (!is_detector(node.type)) continue;
+    detector_summary["type"] = node.type;
+    for (const auto& [key, value] : node.params) detector_summary["params"][key] = value.text;
+  }
   const graph::ResolvedGraph resolved = graph::resolve(std::move(spec));
-
-  const auto started = std::chrono::steady_clock::now();
+  refuse_outputs_over_inputs(args, out, graph_file);
   graph::RunOptions options;
   options.single_process = true;
+  check_ports_free(resolved, options);
+  EarlierOutput earlier = EarlierOutput::prepare(out, args.has("force"));
+
+  const auto started = std::chrono::steady_clock::now();
   ProgressBar bar(!args.has("quiet") && isatty(STDERR_FILENO) != 0);
   ProgressCallback progress;
   if (info.frames > 0) {
@@ -333,62 +585,71 @@ int reconstruct_command(int argc, char** argv) {
       }
     };
   }
-  const graph::RunResult result = run_graph_here(resolved, options, "mocap reconstruct", progress);
+  graph::RunResult result;
+  try {
+    result = run_graph_here(resolved, options, "mocap reconstruct", progress);
+  } catch (...) {
+    std::vector<fs::path> files = reconstruct_outputs_in(out);
+    std::erase_if(files, [](const fs::path& f) { return f.filename() == "summary.json"; });
+    earlier.settle(!files.empty());
+    throw;
+  }
   bar.finish();
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   if (!args.has("quiet")) std::cerr << graph::format_stats_table(result.stats);
 
+  // Every output file in DIR now is this run's: earlier ones were refused or set aside.
+  std::vector<fs::path> files = reconstruct_outputs_in(out);
+  std::erase_if(files, [](const fs::path& f) { return f.filename() == "summary.json"; });
+  const WrittenOutputs written = classify_outputs(files);
+  const bool wrote_output = !files.empty();
+  const bool earlier_put_back = earlier.count() > 0 && !wrote_output;
+  if (const std::string note = earlier.settle(wrote_output); !note.empty())
+    std::cerr << "mocap reconstruct: " << note << "\n";
+  const std::string outcome = !result.ok       ? "failed: " + result.error
+                              : result.stopped ? std::string("interrupted")
+                                               : std::string();
+  if (earlier_put_back || (!wrote_output && !outcome.empty())) {
+    // A run that wrote nothing writes no summary either: the folder stays as it was (an earlier
+    // output is back, its summary.json with it).
+    if (!outcome.empty()) std::cerr << "mocap reconstruct: " << outcome << "\n";
+    std::cerr << "mocap reconstruct: nothing was written into " << out.string() << "\n";
+    return !result.ok ? 1 : result.stopped ? 130 : 0;
+  }
   json summary = summarize_output(out / "poses.jsonl");
-  summary["input"] = args.positionals()[0];
+  summary["input"] = input;
   summary["database"] = args.get("db");
   summary["mode"] = args.get("mode");
   summary["fit"] = fit;
   summary["graph"] = graph_file;
   if (kind == InputKind::video) {
-    summary["detector_size"] = std::stoi(args.get("detector-size"));
+    summary["detector"] = detector_summary;
+    if (args.has("detector-size")) summary["detector_size"] = args.integer("detector-size");
     summary["video"] = {
         {"width", info.width}, {"height", info.height}, {"fps", info.fps}, {"frames", info.frames}};
   }
   summary["seconds"] = seconds;
-  summary["frames_per_second"] = seconds > 0 ? summary["frames"].get<double>() / seconds : 0.0;
+  const double frames_per_second = seconds > 0 ? summary["frames"].get<double>() / seconds : 0.0;
+  summary["frames_per_second"] = frames_per_second;
   summary["id_switches"] =
       nullptr;  // needs ground-truth identities: see `mocap eval` and the tracker tests
   summary["nodes"] = node_latency(result.stats);
   summary["completed"] = result.ok && !result.stopped;
+  summary["interrupted"] = result.stopped;
+  if (!result.ok) summary["error"] = result.error;
+  summary["files"] = files_json(files);
   summary["git_commit"] = git_commit();
-  std::ofstream(out / "summary.json") << summary.dump(2) << "\n";
+  const fs::path summary_file = out / "summary.json";
+  write_file_atomically(summary_file, json_text(summary, 2) + "\n");
 
-  std::cout << "wrote " << (out / "poses.jsonl").string() << ": " << summary["frames"]
-            << " frames, " << summary["people"] << " people ("
-            << summary["tracks_longer_than_50_frames"] << " tracks longer than 50 frames), "
-            << std::fixed << std::setprecision(1) << summary["frames_per_second"].get<double>()
-            << " frames/s\n";
-  std::vector<std::string> written;
-  for (const auto& e : fs::directory_iterator(out)) {
-    if (e.path().extension() == ".bvh" || e.path().extension() == ".mp4")
-      written.push_back(e.path().string());
+  print_written(out, written, summary, frames_per_second);
+  std::cout << "wrote " << summary_file.string() << "\n";
+  if (!outcome.empty()) {
+    std::cerr << "mocap reconstruct: " << outcome << "\n"
+              << "mocap reconstruct: " << incomplete_note(written, summary, info.frames) << "\n";
   }
-  std::sort(written.begin(), written.end(), [](const std::string& a, const std::string& b) {
-    return a.size() != b.size() ? a.size() < b.size() : a < b;  // person_2 before person_10
-  });
-  // Many people: the BVH files in one line, not one line each.
-  std::size_t bvh = 0;
-  for (const std::string& file : written) {
-    if (written.size() > 8 && file.ends_with(".bvh")) {
-      ++bvh;
-    } else {
-      std::cout << "wrote " << file << "\n";
-    }
-  }
-  if (bvh > 0)
-    std::cout << "wrote " << bvh
-              << " BVH files, one per person: " << (out / "person_<id>.bvh").string() << "\n";
-  std::cout << "wrote " << (out / "summary.json").string() << "\n";
-  if (!result.ok) {
-    std::cerr << "mocap reconstruct: " << result.error << "\n";
-    return 1;
-  }
+  if (!result.ok) return 1;
   return result.stopped ? 130 : 0;
 }
 

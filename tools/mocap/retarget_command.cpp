@@ -12,6 +12,7 @@
 #include "core/input_error.hpp"
 #include "motion/bvh.hpp"
 #include "motion/retarget.hpp"
+#include "output_files.hpp"
 
 namespace mocap::cli {
 namespace {
@@ -44,7 +45,8 @@ int retarget_command(int argc, char** argv) {
       .option("map", "FILE",
               "explicit joint pairs, lines 'source_joint target_joint' ('#' comments); they "
               "override the automatic matches (needed for rigs with unknown joint names)")
-      .option("scale", "auto|S", "target units per source unit for the root translation", "auto");
+      .option("scale", "auto|S", "target units per source unit for the root translation", "auto",
+              Range::positive().or_word("auto"));
   int code = 0;
   if (!args.parse(argc, argv, code)) return code;
   if (!args.has("rig")) throw InputError("mocap retarget", "--rig TARGET.bvh is required");
@@ -52,6 +54,8 @@ int retarget_command(int argc, char** argv) {
 
   const std::string in_path = args.positionals().at(0);
   const std::string rig_path = args.get("rig");
+  refuse_output_over_inputs({"--out", args.get("out")},
+                            {{"IN.bvh", in_path}, {"--rig", rig_path}, {"--map", args.get("map")}});
   const motion::Clip source = motion::read_bvh(in_path);
   if (source.frame_count == 0) throw InputError(in_path, "the motion has no frames");
   const motion::Skeleton rig = motion::read_rig(rig_path);

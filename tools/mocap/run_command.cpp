@@ -67,11 +67,12 @@ int run_command(int argc, char** argv) {
       .option("set", "NODE.PARAM=VALUE", "override a node parameter", std::nullopt, true)
       .option("process", "NAME", "run only this process group of the graph")
       .flag("single-process", "run every node here, ignoring placement and edge transports")
-      .option("max-restarts", "N", "restarts of a dead process group before giving up", "5")
+      .option("max-restarts", "N", "restarts of a dead process group before giving up", "5",
+              Range::count(0, 1'000'000))
       .option("drain-timeout", "MS",
               "after a stop, how long to go on processing what is queued and to wait for other "
               "processes; then the rest is counted and left",
-              "1500")
+              "1500", Range::count(0, 3'600'000))
       .flag("quiet", "do not print statistics at the end");
   int exit_code = 0;
   if (!args.parse(argc, argv, exit_code)) return exit_code;

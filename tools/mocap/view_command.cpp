@@ -29,17 +29,43 @@ using namespace std::chrono_literals;
 std::optional<web::ShownCamera> camera_of(const Args& args) {
   if (args.has("camera")) return web::ShownCamera{camera::read_camera_file(args.get("camera"))};
   if (!args.has("image-size")) return std::nullopt;
-  const std::string size = args.get("image-size");
-  int width = 0, height = 0;
-  if (std::sscanf(size.c_str(), "%dx%d", &width, &height) != 2 || width <= 0 || height <= 0)
-    throw InputError("--image-size", "expected WIDTHxHEIGHT, got '" + size + "'");
-  return web::ShownCamera{camera::Camera::from_fov(width, height, args.number("hfov")), true};
+  const ImageSize size = args.image_size("image-size");
+  return web::ShownCamera{camera::Camera::from_fov(size.width, size.height, args.number("hfov")),
+                          true};
+}
+
+// The recording's 2D keypoints must lie in the image the camera says: a smaller image would draw
+// them, and the frustum, wrong.
+void check_keypoints_inside(const web::Recording& recording,
+                            const std::optional<web::ShownCamera>& shown, const std::string& path,
+                            const Args& args) {
+  if (!shown) return;
+  const camera::Camera& camera = shown->camera;
+  for (std::size_t f = 0; f < recording.frames.size(); ++f) {
+    for (const Person3D& person : recording.frames[f].people) {
+      for (const Keypoint2D& k : person.keypoints) {
+        if (!(k.confidence > 0.0f)) continue;
+        if (k.x <= static_cast<float>(camera.width) + 1.0f &&
+            k.y <= static_cast<float>(camera.height) + 1.0f)
+          continue;
+        throw InputError(args.has("camera") ? args.get("camera") : "--image-size",
+                         std::to_string(camera.width) + "x" + std::to_string(camera.height) +
+                             " is smaller than the keypoints of " + path + " (frame " +
+                             std::to_string(f) + " has one at " + std::to_string(k.x) + ", " +
+                             std::to_string(k.y) + "): give the size of the input images");
+      }
+    }
+  }
 }
 
 int view_recording(const Args& args) {
   const std::string path = args.positionals()[0];
   const web::Recording recording = web::read_poses_jsonl(path, args.number("fps"));
+  if (recording.cut_last_line)
+    std::cerr << "mocap view: " << path
+              << ": the last line is cut (the writer was killed while writing it): skipped\n";
   const std::optional<web::ShownCamera> camera = camera_of(args);
+  check_keypoints_inside(recording, camera, path, args);
 
   std::mutex mutex;
   std::condition_variable changed;
@@ -175,12 +201,17 @@ int view_command(int argc, char** argv) {
               "address to serve on (0.0.0.0: every interface, with --allow-network)", "127.0.0.1")
       .flag("allow-network",
             "let --host be an address other machines reach (the page has no authentication)")
-      .option("port", "P", "TCP port; 0 picks a free one (graph: 8080 unless given)", "8080")
-      .option("queue", "N", "frames waiting per browser before the oldest is dropped", "4")
-      .option("fps", "F", "frame rate of a recording without usable times", "30")
+      .option("port", "P", "TCP port; 0 picks a free one (graph: 8080 unless given)", "8080",
+              Range::count(0, 65535))
+      .option("queue", "N", "frames waiting per browser before the oldest is dropped", "4",
+              Range::count(1, 1000))
+      .option("fps", "F", "frame rate of a recording without usable times", "30",
+              Range::between(0.1, 1000.0))
       .option("camera", "FILE", "camera file (a rig file of one camera): draw its frustum")
-      .option("image-size", "WxH", "or the image size, with --hfov, for an assumed camera")
-      .option("hfov", "DEG", "horizontal field of view with --image-size", "60")
+      .option("image-size", "WxH", "or the image size, with --hfov, for an assumed camera",
+              std::nullopt, Range::image_size())
+      .option("hfov", "DEG", "horizontal field of view with --image-size", "60",
+              Range::between(1.0, 179.0))
       .flag("quiet", "do not print the graph's statistics at the end");
   int exit_code = 0;
   if (!args.parse(argc, argv, exit_code)) return exit_code;

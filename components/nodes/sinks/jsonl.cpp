@@ -9,21 +9,22 @@
 // reconstruction), `keypoints` (the 15 body joints' 2D input, image
 // pixels as detected and confidence, 0 0 0 where missing) for people reconstructed from a 2D
 // detection, so that a recording can be replayed beside its input (mocap view), `ground` once the
-// floor is known (points p
-// with normal . p + offset = 0, normal up). Each line is flushed as it is written, so the file
-// holds every finished frame even if the run is killed.
+// floor is known (points p with normal . p + offset = 0, normal up).
+//
+// The file is written through io::LineFile: created when the first frame arrives (a run that
+// fails before leaves an earlier file untouched), one write per line, so the file holds every
+// finished frame even if the run is killed; a kill in the middle of a write can only leave the
+// last line cut, without its newline (readers skip such a tail: web::read_poses_jsonl, mocap
+// reconstruct's summary).
 
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
-#include <cstdio>
-#include <cstring>
-#include <memory>
+#include <optional>
 
 #include <nlohmann/json.hpp>
 
-#include "core/input_error.hpp"
 #include "graph/registry.hpp"
+#include "io/line_file.hpp"
 
 namespace mocap::nodes {
 using namespace mocap::graph;
@@ -33,13 +34,16 @@ class JsonLinesSink : public Node {
   static void contract(Contract& c) {
     c.doc("Writes one JSON line per frame with every person's 15 joints");
     c.input<People3D>("in");
-    c.required_param<std::string>("path", "file to write (poses.jsonl)");
+    c.required_param<std::string>(
+        "path",
+        "file to write (poses.jsonl; its folder made at the start, the file at the first frame)");
   }
+  // The file is created when the first frame arrives, so that a run failing before it (a busy
+  // port, a bad parameter of another node) leaves an earlier file of that name untouched; that
+  // it can be written is checked now, without touching it, so such a run still fails at once.
   void open(Context& ctx) override {
-    path_ = ctx.param<std::string>("path");
-    file_.reset(std::fopen(path_.c_str(), "w"));
-    if (!file_)
-      throw InputError(path_, std::string("cannot create the file: ") + std::strerror(errno));
+    file_.emplace(ctx.param<std::string>("path"));
+    file_->check_writable();
   }
   void process(Context& ctx) override {
     const auto& in = ctx.input<People3D>("in");
@@ -59,12 +63,7 @@ class JsonLinesSink : public Node {
       line["ground"] = {{"normal", {in.ground.normal.x, in.ground.normal.y, in.ground.normal.z}},
                         {"offset", round_mm(static_cast<float>(in.ground.offset))}};
     }
-    const std::string text = line.dump() + "\n";
-    if (std::fwrite(text.data(), 1, text.size(), file_.get()) != text.size() ||
-        std::fflush(file_.get()) != 0) {
-      throw InputError(path_, std::string("write failed: ") + std::strerror(errno) +
-                                  " (disk full or over the file size limit?)");
-    }
+    file_->write(line.dump());
   }
   void close(Context&) override { file_.reset(); }
 
@@ -94,11 +93,7 @@ class JsonLinesSink : public Node {
   }
   // Millimetre precision keeps the file small and the numbers readable.
   static double round_mm(float v) { return std::round(static_cast<double>(v) * 1000.0) / 1000.0; }
-  struct Closer {
-    void operator()(std::FILE* f) const { std::fclose(f); }
-  };
-  std::string path_;
-  std::unique_ptr<std::FILE, Closer> file_;
+  std::optional<io::LineFile> file_;
 };
 
 MOCAP_REGISTER_NODE("sink.jsonl", JsonLinesSink)

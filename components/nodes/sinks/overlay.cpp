@@ -1,13 +1,17 @@
 // sink.overlay: the 2D input beside the 3D result, as an MP4 video and/or PNG snapshots. The
-// inputs arrive unsynchronised on their ports; frames are joined by number (viz/overlay_inputs)
-// and drawn by viz/overlay_renderer.
+// framework joins the inputs by frame number (Contract::join, graph/synchronizer.hpp): process()
+// sees one frame's 2D people, 3D people and video frame, each present or missing; a frame with
+// both people is drawn (viz/overlay_renderer), on its video frame when there is one. With
+// `video_path` the frame under the people is read again from the file by its number
+// (video::FrameReader) instead of coming on the `video` port, so no decoded frame waits here for
+// its 3D (the offline fit sends it a window later).
 
-#include <chrono>
 #include <iostream>
 #include <memory>
+#include <optional>
 
 #include "graph/registry.hpp"
-#include "viz/overlay_inputs.hpp"
+#include "video/frame_reader.hpp"
 #include "viz/overlay_output.hpp"
 #include "viz/overlay_renderer.hpp"
 
@@ -20,9 +24,16 @@ class OverlaySink : public Node {
     c.doc("Draws the 2D input beside the 3D skeletons (second viewpoint) into an MP4 and/or PNGs");
     c.input<People2D>("people2d", "the tracked 2D people (any keypoint layout)");
     c.input<People3D>("people3d", "the reconstructed 3D people");
-    c.input<VideoFrame>("video", "the frames the 2D people were found in (drawn under them)",
+    c.input<VideoFrame>("video",
+                        "the frames the 2D people were found in (drawn under them); unused "
+                        "with video_path",
                         PortFlag::optional);
-    c.param<std::string>("video", "", "MP4 file to write (codec mp4v); empty: none");
+    c.param<std::string>("video_path", "",
+                         "video file or image folder the 2D people were found in, read again by "
+                         "frame number (instead of the video port; not for cameras and streams)");
+    c.param<std::string>("video", "",
+                         "MP4 file to write (fragmented, H.264: plays even if the run is killed); "
+                         "empty: none");
     c.param<double>("fps", 30.0, "frame rate of the MP4", {0.1, 1000.0});
     c.param<std::int64_t>("png_every", 0, "a PNG of every Nth drawn frame; 0: none", {0, 1e9});
     c.param<std::string>("png_dir", "", "folder for the PNGs (overlay_<frame>.png)");
@@ -32,9 +43,10 @@ class OverlaySink : public Node {
                           {16, 16384});
     c.param<std::int64_t>("panel_height", 480, "output height in pixels", {16, 16384});
     c.param<double>("view_yaw_deg", 35.0, "3D view: turn about the vertical", {-180.0, 180.0});
-    c.param<double>("view_pitch_deg", 20.0, "3D view: looking down by", {-89.0, 89.0});
-    c.param<std::int64_t>("max_pending", 64, "incomplete frames kept at most", {1, 100000});
-    c.param<bool>("wait_for_video", false, "draw a frame only once its video frame is there");
+    c.param<double>("view_pitch_deg", 30.0, "3D view: looking down by", {-89.0, 89.0});
+    // The 3D of a frame comes after its 2D by the lag of the stages between (the offline fit
+    // works in windows of 64 frames per person): held up to sync_bound frames per input.
+    c.join({{"people2d", "people3d", "video"}, SyncKey::frame, 256});
   }
 
   void open(Context& ctx) override {
@@ -53,53 +65,48 @@ class OverlaySink : public Node {
     look.view_yaw_deg = ctx.param<float>("view_yaw_deg");
     look.view_pitch_deg = ctx.param<float>("view_pitch_deg");
     renderer_ = std::make_unique<viz::OverlayRenderer>(look);
-    inputs_ = std::make_unique<viz::OverlayInputs>(ctx.param<std::size_t>("max_pending"),
-                                                   ctx.param<bool>("wait_for_video"));
+    if (const auto path = ctx.param<std::string>("video_path"); !path.empty())
+      frames_.emplace(path);
   }
 
   void process(Context& ctx) override {
-    const std::int64_t dropped_before = inputs_->dropped();
-    if (ctx.has("people2d")) inputs_->add(ctx.input_ptr<People2D>("people2d"));
-    if (ctx.has("people3d")) inputs_->add(ctx.input_ptr<People3D>("people3d"));
-    if (ctx.has("video")) inputs_->add(ctx.input_ptr<VideoFrame>("video"));
-    draw(inputs_->take_ready());
-    for (auto d = dropped_before; d < inputs_->dropped(); ++d) ctx.count_drop();
+    if (!ctx.has("people2d") || !ctx.has("people3d")) {
+      // A frame the detector skipped (video only) is no loss; 2D without 3D or the reverse is
+      // (the synchroniser's line in the statistics says which input was missing or late).
+      if (ctx.has("people2d") || ctx.has("people3d")) {
+        ++undrawn_;
+        ctx.count_drop();
+      }
+      return;
+    }
+    const auto& people3d = ctx.input<People3D>("people3d");
+    ImageBuffer background =
+        ctx.has("video") ? ctx.input<VideoFrame>("video").image : ImageBuffer();
+    if (frames_) {
+      if (auto frame = frames_->frame(people3d.header.frame)) background = std::move(frame->image);
+    }
+    output_->write(renderer_->render(ctx.input<People2D>("people2d"), people3d, background,
+                                     {people3d.header.frame, output_->pictures_per_second()}),
+                   people3d.header.frame);
   }
 
   void close(Context& ctx) override {
-    if (!inputs_) return;
-    draw(inputs_->take_remaining());
+    if (!output_) return;
     output_->close();
     std::cerr << "sink.overlay '" << ctx.node_name() << "': " << output_->pictures()
-              << " frames drawn, " << inputs_->dropped() << " dropped, " << output_->pngs()
-              << " PNGs\n";
+              << " frames drawn, " << undrawn_ << " with only 2D or only 3D people, "
+              << output_->pngs() << " PNGs";
+    if (frames_)
+      std::cerr << "; " << frames_->returned() << " video frames read again, "
+                << frames_->passed_over() << " passed over, " << frames_->reopened() << " restarts";
+    std::cerr << "\n";
   }
 
  private:
-  void draw(const std::vector<viz::OverlayFrame>& frames) {
-    for (const viz::OverlayFrame& f : frames) {
-      const ImageBuffer background = f.video ? f.video->image : ImageBuffer();
-      output_->write(renderer_->render(*f.people2d, *f.people3d, background, {f.frame, rate()}),
-                     f.frame);
-    }
-  }
-
-  // Frames drawn per second of wall-clock time, smoothed: how fast the whole graph runs.
-  double rate() {
-    const auto now = std::chrono::steady_clock::now();
-    if (last_ != std::chrono::steady_clock::time_point{}) {
-      const double seconds = std::chrono::duration<double>(now - last_).count();
-      if (seconds > 0.0) fps_ = fps_ > 0.0 ? 0.9 * fps_ + 0.1 / seconds : 1.0 / seconds;
-    }
-    last_ = now;
-    return fps_;
-  }
-
   std::unique_ptr<viz::OverlayOutput> output_;
   std::unique_ptr<viz::OverlayRenderer> renderer_;
-  std::unique_ptr<viz::OverlayInputs> inputs_;
-  std::chrono::steady_clock::time_point last_{};
-  double fps_ = 0.0;
+  std::optional<video::FrameReader> frames_;  // with video_path
+  std::int64_t undrawn_ = 0;
 };
 
 MOCAP_REGISTER_NODE("sink.overlay", OverlaySink)

@@ -18,9 +18,9 @@ class OpenPoseJsonSource : public Node {
     c.output<People2D>("out", "2D keypoints of every person, untracked (id -1)");
     c.required_param<std::string>("path", "folder of *_keypoints.json files");
     c.param<double>("fps", 30.0, "frame rate of the video the keypoints came from", {0.1, 1000.0});
-    c.param<std::string>("layout", "auto",
-                         "auto (detect BODY_25/BODY_25B by the keypoints), BODY_25, BODY_25B; "
-                         "18 keypoints are COCO-18 in any case");
+    c.param_choice("layout", "auto", {"auto", "BODY_25", "BODY_25B"},
+                   "auto (detect BODY_25/BODY_25B by the keypoints), BODY_25, BODY_25B; 18 "
+                   "keypoints are COCO-18 in any case");
     c.param<std::string>("stream", "", "stream id of the messages (default: the folder)");
     c.param<std::string>("camera", std::string(kDefaultCamera),
                          "the name of the camera the keypoints were detected in (as in the rig "
@@ -29,16 +29,10 @@ class OpenPoseJsonSource : public Node {
 
   void open(Context& ctx) override {
     io::OpenPoseOptions options;
-    const std::string layout = ctx.param<std::string>("layout");
-    if (layout == "auto") {
-      options.body25 = io::Body25Choice::detect;
-    } else if (const KeypointLayout* l = find_layout(layout); l && l->id == LayoutId::body25b) {
-      options.body25 = io::Body25Choice::body25b;
-    } else if (l && l->id == LayoutId::body25) {
-      options.body25 = io::Body25Choice::body25;
-    } else {
-      throw std::invalid_argument("layout must be auto, BODY_25 or BODY_25B, not '" + layout + "'");
-    }
+    const std::string layout = ctx.param<std::string>("layout");  // a choice: checked already
+    options.body25 = layout == "auto"       ? io::Body25Choice::detect
+                     : layout == "BODY_25B" ? io::Body25Choice::body25b
+                                            : io::Body25Choice::body25;
     sequence_ = io::read_openpose_folder(ctx.param<std::string>("path"), options);
     for (const auto& p : sequence_.problems)
       std::cerr << ctx.node_name() << ": " << p.message << "\n";

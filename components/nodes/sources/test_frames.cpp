@@ -17,7 +17,7 @@ class TestFrames : public Node {
     c.param<std::int64_t>("count", 10, "frames before end of stream (0: until stopped)", {0, 1e12});
     c.param<std::int64_t>("width", 640, "pixels", {1, 16384});
     c.param<std::int64_t>("height", 480, "pixels", {1, 16384});
-    c.param<std::string>("format", "rgb8", "pixel format: gray8, rgb8, bgr8, rgba8, bgra8");
+    c.param_choice("format", "rgb8", {"gray8", "rgb8", "bgr8", "rgba8", "bgra8"}, "pixel format");
     c.param<double>("fps", 0.0, "frames per second (0: as fast as possible)", {0, 1000});
     c.param<std::string>("camera", std::string(kDefaultCamera), "camera name (also the stream id)");
   }
@@ -27,11 +27,7 @@ class TestFrames : public Node {
     width_ = ctx.param<int>("width");
     height_ = ctx.param<int>("height");
     camera_ = ctx.param<std::string>("camera");
-    const auto format = pixel_format_from_name(ctx.param<std::string>("format"));
-    if (!format)
-      throw std::invalid_argument("unknown pixel format '" + ctx.param<std::string>("format") +
-                                  "'");
-    format_ = *format;
+    format_ = pixel_format_from_name(ctx.param<std::string>("format")).value();  // a choice
     const double fps = ctx.param<double>("fps");
     interval_ = std::chrono::nanoseconds(fps > 0 ? static_cast<std::int64_t>(1e9 / fps) : 0);
   }

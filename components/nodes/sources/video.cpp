@@ -9,6 +9,11 @@
 // Live frames are stamped with their capture time (CLOCK_REALTIME). Either way, put a `latest` edge
 // after this node so that a slow consumer takes the newest frame.
 //
+// The end: a file, or a file served over HTTP/RTSP, that stops well before the frames its
+// container announces (truncated, connection lost) stops the graph with an error naming the input,
+// so the run ends incomplete (exit 1) instead of looking finished; a live stream announces no
+// count and ends when its sender stops.
+//
 // loop: a file or folder starts again at its end (soak tests, installations); sequence numbers
 // go on counting, offline stamps go on from the end of the previous pass. Damaged frames that
 // FFmpeg could not decode are skipped: counted as drops, logged and shown in the status line.
@@ -31,9 +36,9 @@ class VideoSourceNode : public Node {
     c.output<VideoFrame>("frames", "bgr8 frames with their capture time");
     c.required_param<std::string>(
         "path", "video file, /dev/videoN (or N), rtsp:// or http:// URL, or folder of images");
-    c.param<std::string>("mode", "auto",
-                         "offline (every frame, as fast as possible), live (paced to the source, "
-                         "late frames skipped) or auto (live for devices and streams)");
+    c.param_choice("mode", "auto", {"offline", "live", "auto"},
+                   "offline (every frame, as fast as possible), live (paced to the source, late "
+                   "frames skipped) or auto (live for devices and streams)");
     c.param<int>("decoder_threads", 0,
                  "FFmpeg decoding threads (0: one per core; needs OpenCV >= 4.7)", {0, 64});
     c.param<double>("fps", 0.0, "frame rate of an image folder (0: 30); devices: mode to ask for",
@@ -60,14 +65,8 @@ class VideoSourceNode : public Node {
     path_ = path;
     options_ = options;
     source_.emplace(path, options);
-    const std::string mode = ctx.param<std::string>("mode");
-    if (mode == "auto") {
-      live_ = source_->live();
-    } else if (mode == "live" || mode == "offline") {
-      live_ = mode == "live";
-    } else {
-      throw std::invalid_argument("mode must be offline, live or auto, not '" + mode + "'");
-    }
+    const std::string mode = ctx.param<std::string>("mode");  // a choice: checked before open()
+    live_ = mode == "auto" ? source_->live() : mode == "live";
     count_ = ctx.param<std::uint64_t>("count");
     loop_ = ctx.param<bool>("loop") && !source_->live();
     camera_ = ctx.param<std::string>("camera");

@@ -1,0 +1,70 @@
+#pragma once
+// MoveNet single-pose (Lightning 192 × 192, Thunder 256 × 256): the keypoints of the one person
+// nearest the centre of a square crop. The CNN (MobileNetV2 + FPN + four CenterNet heads) runs on
+// either network runtime through GraphRunner; the graph's own post-processing (argmax, gathers) is
+// decode_singlepose here, the arithmetic read from the graph and its constants
+// (docs/detection-strategies.md):
+//
+//  1. centre = σ(centre logit) · w(y, x), w = 1 / (distance to the grid centre (h/2, w/2) + 1.8);
+//     the centre cell (cy, cx) is its first maximum in row-major order;
+//  2. per keypoint k, the regressed position r_k = (cy, cx) + regress_k(cy, cx);
+//  3. S_k(Y, X) = σ(heatmap_k(Y, X)) / (|(Y, X) − r_k| + 1.8); (Y*, X*) its first maximum;
+//  4. y = (Y* + offset_k,y(Y*, X*)) · f, x = (X* + offset_k,x(Y*, X*)) · f with f = 1/h as the
+//     model stores it (float16), score = σ(heatmap_k(Y*, X*)).
+// Many crops go through one forward pass (batch N): the graph is fed after its batch-of-one input
+// reshuffles.
+
+#include <array>
+#include <filesystem>
+#include <memory>
+#include <span>
+#include <string_view>
+#include <vector>
+
+#include "detect/graph_runner.hpp"
+#include "detect/movenet_decoder.hpp"
+
+namespace mocap::detect {
+
+enum class SinglePoseModel { lightning, thunder };
+
+// "movenet-lightning" / "movenet-thunder": the model's folder in the cache.
+std::string_view model_name(SinglePoseModel model);
+// 192 / 256: the square crop the model takes.
+int input_size(SinglePoseModel model);
+
+// The model's own output for one crop: 17 × (y, x, score), y and x normalised to the crop.
+using SinglePoseKeypoints = std::array<std::array<float, 3>, kMovenetKeypoints>;
+
+// Decodes crop n of the four heads (NHWC [N, H, W, C]: centre 1, heatmap 17, regress 34, offset
+// 34 channels). Throws std::invalid_argument when the heads do not fit together.
+SinglePoseKeypoints decode_singlepose(const GraphTensor& center, const GraphTensor& heatmap,
+                                      const GraphTensor& regress, const GraphTensor& offset, int n);
+
+class SinglePoseNetwork {
+ public:
+  // Throws std::runtime_error (naming the file and the fetch command) when it cannot be loaded.
+  // options.input_node is set here.
+  SinglePoseNetwork(SinglePoseModel model, const std::filesystem::path& model_json,
+                    const RunnerOptions& options = {});
+
+  SinglePoseModel model() const { return model_; }
+  int input_size() const { return detect::input_size(model_); }
+  Backend backend() const { return runner_->backend(); }
+
+  // The heads for a batch of crops: NHWC [N, size, size, 3] float RGB 0..255, size =
+  // input_size(). In the order center, heatmap, regress, offset; valid until the next call.
+  const std::vector<GraphTensor>& run_heads(const GraphTensor& crops);
+  // The keypoints of every crop of the batch, run in passes of 8, 4, 2 and 1 crops: the XNNPACK
+  // runtime builds itself per input shape (about 0.3 s) and keeps the last 4, so whatever the
+  // number of people, these four shapes are all it ever builds.
+  std::vector<SinglePoseKeypoints> run(const GraphTensor& crops);
+
+ private:
+  SinglePoseModel model_;
+  std::unique_ptr<GraphRunner> runner_;
+  std::vector<GraphTensor> heads_;  // reused from call to call
+  GraphTensor pass_;                // the crops of one pass
+};
+
+}  // namespace mocap::detect

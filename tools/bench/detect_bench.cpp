@@ -1,0 +1,392 @@
+// mocap-bench-detect: the detection strategies side by side on real inputs (issue 18). Per input
+// and strategy: recall and precision against the hand-checked boxes of tests/data/detection/,
+// median keypoint distance to the reference strategy (the first listed), people per frame over
+// every frame, and frames/s end to end (decoding + detection, offline, every frame in order, so
+// that strategies that follow people between detector runs work as they would on the file). Each
+// strategy runs on each network runtime asked for (--backends: cv::dnn, XNNPACK). The networks'
+// forward time alone is mocap-bench-networks'.
+// Prints a Markdown table per input; --json writes every number.
+//
+// Also the tool that made the boxes: --candidates DIR writes the reference strategy's boxes on
+// the frames to annotate in the truth format, --draw DIR the frames with the truth (green),
+// ignored people (yellow) and the reference strategy's people (red, numbered) on a 50-px grid.
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <iostream>
+#include <map>
+#include <memory>
+#include <sstream>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "cli_args.hpp"
+#include "detect/model_files.hpp"
+#include "detect/movenet_detector.hpp"
+#include "detect/tiled_detector.hpp"
+#include "detect/topdown_detector.hpp"
+#include "eval/detection_truth.hpp"
+#include "video/video_source.hpp"
+
+namespace {
+
+using namespace mocap;
+namespace fs = std::filesystem;
+using nlohmann::json;
+using Clock = std::chrono::steady_clock;
+using People = std::vector<detect::MovenetPerson>;
+
+struct Strategy {
+  std::string name;
+  std::function<People(const ImageBuffer&)> detect;
+  std::function<void()> reset = [] {};
+};
+
+std::vector<std::string> split(const std::string& text, char sep) {
+  std::vector<std::string> out;
+  std::stringstream in(text);
+  for (std::string item; std::getline(in, item, sep);)
+    if (!item.empty()) out.push_back(item);
+  return out;
+}
+
+// multipose:SIZE | tiles:CxR:TILE:FRAME | topdown:lightning|thunder:EVERY, on `backend`.
+Strategy make_strategy(const std::string& spec, detect::Backend backend, int threads) {
+  const auto parts = split(spec, ':');
+  if (parts.size() == 2 && parts[0] == "multipose") {
+    detect::MovenetOptions o;
+    o.input_size = std::stoi(parts[1]);
+    o.backend = backend;
+    o.threads = threads;
+    auto d = std::make_shared<detect::MovenetDetector>(detect::movenet_model_json(), o);
+    return {spec, [d](const ImageBuffer& f) { return d->detect(f); }};
+  }
+  if (parts.size() == 4 && parts[0] == "tiles") {
+    detect::TileOptions o;
+    const auto grid = split(parts[1], 'x');
+    if (grid.size() != 2) throw std::invalid_argument("tiles:CxR:TILE:FRAME, got " + spec);
+    o.columns = std::stoi(grid[0]);
+    o.rows = std::stoi(grid[1]);
+    o.tile_input_size = std::stoi(parts[2]);
+    o.frame_input_size = std::stoi(parts[3]);
+    o.backend = backend;
+    o.threads = threads;
+    auto d = std::make_shared<detect::TiledDetector>(detect::movenet_model_json(), o);
+    return {spec, [d](const ImageBuffer& f) { return d->detect(f); }};
+  }
+  if (parts.size() == 3 && parts[0] == "topdown") {
+    detect::TopDownOptions o;
+    if (parts[1] != "lightning" && parts[1] != "thunder")
+      throw std::invalid_argument("topdown:lightning|thunder:EVERY, got " + spec);
+    o.pose_model = parts[1] == "thunder" ? detect::SinglePoseModel::thunder
+                                         : detect::SinglePoseModel::lightning;
+    o.detect_every = std::stoi(parts[2]);
+    o.backend = backend;
+    o.threads = threads;
+    auto d = std::make_shared<detect::TopDownDetector>(
+        o, detect::cached_model_json(detect::model_name(o.pose_model)),
+        detect::cached_model_json("centernet"));
+    return {spec, [d](const ImageBuffer& f) { return d->detect(f); }, [d] { d->reset(); }};
+  }
+  throw std::invalid_argument("unknown strategy '" + spec +
+                              "' (multipose:SIZE, tiles:CxR:TILE:FRAME, topdown:MODEL:EVERY)");
+}
+
+// Every frame of a video, or the one image of a still.
+class Frames {
+ public:
+  explicit Frames(const std::string& path) : path_(path) {
+    if (video::is_image_file_name(fs::path(path).filename().string())) {
+      still_ = cv::imread(path);
+      if (still_.empty()) throw std::runtime_error("cannot read " + path);
+    } else {
+      source_ = std::make_unique<video::VideoSource>(path);
+    }
+  }
+  std::optional<ImageBuffer> next() {
+    if (source_) {
+      auto f = source_->read();
+      if (!f) return std::nullopt;
+      return f->image;
+    }
+    if (done_) return std::nullopt;
+    done_ = true;
+    auto owner = std::make_shared<cv::Mat>(still_);
+    return ImageBuffer(still_.cols, still_.rows, static_cast<int>(still_.step[0]),
+                       PixelFormat::bgr8, owner, reinterpret_cast<const std::byte*>(owner->data));
+  }
+
+ private:
+  std::string path_;
+  cv::Mat still_;
+  bool done_ = false;
+  std::unique_ptr<video::VideoSource> source_;
+};
+
+struct Run {
+  std::map<int, People> people;  // every frame
+  double seconds = 0;
+  int frames = 0;
+};
+
+// Every frame in order, or only those in `only` (sorted; empty: all).
+Run run(Strategy& s, const std::string& input, const std::vector<int>& only) {
+  Run r;
+  {
+    // cv::dnn sets its layers up on the first forward pass (several times a later one): done
+    // before the clock starts, on the first frame, and forgotten.
+    Frames warm_up(input);
+    if (auto f = warm_up.next()) s.detect(*f);
+    s.reset();
+  }
+  Frames frames(input);
+  const auto start = Clock::now();
+  for (int i = 0;; ++i) {
+    auto f = frames.next();
+    if (!f) break;
+    if (!only.empty() && !std::binary_search(only.begin(), only.end(), i)) continue;
+    r.people[i] = s.detect(*f);
+    ++r.frames;
+  }
+  r.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  return r;
+}
+
+bool present(const Keypoint2D& k) { return std::isfinite(k.x) && k.confidence > 0; }
+
+std::vector<Box2D> boxes(const People& people) {
+  std::vector<Box2D> out;
+  for (const auto& p : people) out.push_back(p.box);
+  return out;
+}
+
+// Distances of each person's keypoints to those of the reference person with the most
+// overlapping box (IoU >= 0.5), over keypoints both have.
+void keypoint_distances(const People& people, const People& reference, std::vector<double>& out) {
+  for (const auto& p : people) {
+    const detect::MovenetPerson* best = nullptr;
+    float best_iou = 0.5f;
+    for (const auto& r : reference) {
+      const float v = detect::iou(p.box, r.box);
+      if (v >= best_iou) best = &r, best_iou = v;
+    }
+    if (!best) continue;
+    for (int k = 0; k < detect::kMovenetKeypoints; ++k)
+      if (present(p.keypoints[k]) && present(best->keypoints[k]))
+        out.push_back(std::hypot(p.keypoints[k].x - best->keypoints[k].x,
+                                 p.keypoints[k].y - best->keypoints[k].y));
+  }
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return std::nan("");
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+void draw(const std::string& input, const eval::DetectionTruth* truth, const std::vector<int>& at,
+          const Run& reference, const fs::path& dir, const std::string& stem) {
+  fs::create_directories(dir);
+  Frames frames(input);
+  for (int i = 0;; ++i) {
+    auto f = frames.next();
+    if (!f) break;
+    if (!std::binary_search(at.begin(), at.end(), i)) continue;
+    cv::Mat img = cv::Mat(f->height(), f->width(), CV_8UC3, const_cast<std::byte*>(f->data()),
+                          static_cast<std::size_t>(f->stride()))
+                      .clone();
+    for (int x = 0; x < img.cols; x += 50)
+      cv::line(img, {x, 0}, {x, img.rows},
+               x % 100 ? cv::Scalar(90, 90, 90) : cv::Scalar(160, 160, 160));
+    for (int y = 0; y < img.rows; y += 50)
+      cv::line(img, {0, y}, {img.cols, y},
+               y % 100 ? cv::Scalar(90, 90, 90) : cv::Scalar(160, 160, 160));
+    for (int x = 0; x < img.cols; x += 100)
+      cv::putText(img, std::to_string(x), {x + 2, 12}, cv::FONT_HERSHEY_PLAIN, 0.9,
+                  {255, 255, 255});
+    for (int y = 100; y < img.rows; y += 100)
+      cv::putText(img, std::to_string(y), {2, y - 2}, cv::FONT_HERSHEY_PLAIN, 0.9, {255, 255, 255});
+    const auto rect = [](const Box2D& b) {
+      return cv::Rect(cv::Point(static_cast<int>(b.x), static_cast<int>(b.y)),
+                      cv::Point(static_cast<int>(b.x + b.width), static_cast<int>(b.y + b.height)));
+    };
+    if (truth) {
+      for (const auto& t : truth->frames) {
+        if (t.frame != i) continue;
+        for (const Box2D& b : t.people) cv::rectangle(img, rect(b), {0, 255, 0}, 2);
+        for (const Box2D& b : t.ignore) cv::rectangle(img, rect(b), {0, 255, 255}, 1);
+      }
+    }
+    const auto it = reference.people.find(i);
+    if (it != reference.people.end()) {
+      for (std::size_t n = 0; n < it->second.size(); ++n) {
+        const Box2D& b = it->second[n].box;
+        cv::rectangle(img, rect(b), {0, 0, 255}, 1);
+        cv::putText(img, std::to_string(n), {static_cast<int>(b.x), static_cast<int>(b.y) - 2},
+                    cv::FONT_HERSHEY_PLAIN, 1.0, {0, 0, 255});
+      }
+    }
+    char name[64];
+    std::snprintf(name, sizeof name, "_f%04d.png", i);
+    cv::imwrite((dir / (stem + name)).string(), img);
+  }
+}
+
+json candidates(const std::string& input, const Run& reference, const std::vector<int>& at,
+                float min_height) {
+  json frames = json::array();
+  for (const int i : at) {
+    json people = json::array(), ignore = json::array();
+    const auto it = reference.people.find(i);
+    if (it != reference.people.end()) {
+      for (const auto& p : it->second) {
+        const json box = {std::round(p.box.x), std::round(p.box.y),
+                          std::round(p.box.x + p.box.width), std::round(p.box.y + p.box.height)};
+        (p.box.height >= min_height ? people : ignore).push_back(box);
+      }
+    }
+    frames.push_back({{"frame", i}, {"people", people}, {"ignore", ignore}});
+  }
+  return {{"input", input}, {"min_height", min_height}, {"frames", frames}};
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  cli::Args args("mocap-bench-detect [options]",
+                 "Detection strategies side by side: recall, precision, keypoint distance, "
+                 "people per frame, frames/s, one Markdown table per input");
+  args.option("inputs", "LIST",
+              "videos or stills, comma-separated; the truth of each is TRUTH/<stem>.json",
+              "../shared/data/eval/openpose_examples_media/video.avi,"
+              "/usr/share/doc/opencv-doc/examples/data/vtest.avi,"
+              "../shared/data/eval/opencv_samples/vtest_part0.avi,"
+              "../shared/data/eval/openpose_examples_media/COCO_val2014_000000000241.jpg,"
+              "../shared/data/eval/openpose_examples_media/COCO_val2014_000000000328.jpg,"
+              "../shared/data/eval/openpose_examples_media/COCO_val2014_000000000536.jpg")
+      .option("strategies", "LIST",
+              "the first (on the first runtime) is the reference for keypoint distances: "
+              "multipose:SIZE, "
+              "tiles:CxR:TILE:FRAME, topdown:lightning|thunder:EVERY",
+              "topdown:thunder:1,multipose:256,multipose:512,tiles:2x2:256:256,"
+              "topdown:lightning:1,topdown:lightning:10,topdown:thunder:10")
+      .option("truth", "DIR", "hand-checked boxes", "tests/data/detection")
+      .option("iou", "X", "a detection matches a true box at this IoU", "0.5")
+      .option("backends", "LIST",
+              "network runtimes, each strategy runs on each: auto, xnnpack, opencv", "auto")
+      .option("threads", "N", "network threads (0: XNNPACK 1, cv::dnn OpenCV's default)", "0")
+      .option("json", "FILE", "write every number here")
+      .flag("only-annotated",
+            "detect on the annotated frames only (each one alone: no following between frames; "
+            "quick, for making candidates)")
+      .option("draw", "DIR", "draw the annotated frames with the truth and the reference's people")
+      .option("candidates", "DIR",
+              "write the reference's boxes on the frames to annotate (30 spread over a video when "
+              "it has no truth yet) as <stem>.json");
+  int exit_code = 0;
+  if (!args.parse(argc - 1, argv + 1, exit_code)) return exit_code;
+  try {
+    const float min_iou = std::stof(args.get("iou"));
+    const int threads = static_cast<int>(args.integer("threads"));
+    json report = {{"iou", min_iou}, {"inputs", json::array()}};
+    for (const std::string& input : split(args.get("inputs"), ',')) {
+      const std::string stem = fs::path(input).stem().string();
+      const fs::path truth_file = fs::path(args.get("truth")) / (stem + ".json");
+      std::optional<eval::DetectionTruth> truth;
+      if (fs::exists(truth_file)) truth = eval::read_detection_truth(truth_file);
+      std::vector<int> at;
+      if (truth) {
+        for (const auto& f : truth->frames) at.push_back(f.frame);
+      } else {
+        const int n =
+            static_cast<int>(video::is_image_file_name(fs::path(input).filename().string())
+                                 ? 1
+                                 : video::VideoSource(input).frame_count());
+        const int count = std::min(30, n);
+        for (int k = 0; k < count; ++k) at.push_back(k * n / count);
+      }
+      const std::vector<int> only = args.has("only-annotated") ? at : std::vector<int>{};
+      std::vector<Run> runs;
+      std::vector<std::string> names;
+      for (const std::string& spec : split(args.get("strategies"), ',')) {
+        for (const std::string& runtime : split(args.get("backends"), ',')) {
+          const detect::Backend backend = detect::resolve_backend(detect::parse_backend(runtime));
+          Strategy s = make_strategy(spec, backend, threads);
+          runs.push_back(run(s, input, only));
+          names.push_back(spec + "@" + std::string(detect::backend_name(backend)));
+          std::fprintf(stderr, "%s %s: %d frames, %.1f s\n", stem.c_str(), names.back().c_str(),
+                       runs.back().frames, runs.back().seconds);
+        }
+      }
+      if (args.has("candidates")) {
+        fs::create_directories(args.get("candidates"));
+        std::ofstream(fs::path(args.get("candidates")) / (stem + ".json"))
+            << candidates(input, runs.front(), at, truth ? truth->min_height : 40.0f).dump(1)
+            << "\n";
+      }
+      if (args.has("draw"))
+        draw(input, truth ? &*truth : nullptr, at, runs.front(), args.get("draw"), stem);
+
+      json rows = json::array();
+      std::printf("\n### %s (%d frames%s)\n\n", input.c_str(), runs.front().frames,
+                  truth ? (", " + std::to_string(truth->frames.size()) + " annotated").c_str()
+                        : ", no truth");
+      std::printf(
+          "| strategy | recall | precision | true people | median kp dist to %s (px) | "
+          "people/frame | frames/s |\n|---|---|---|---|---|---|---|\n",
+          names.front().c_str());
+      for (std::size_t s = 0; s < runs.size(); ++s) {
+        int truths = 0, counted = 0, matched = 0;
+        if (truth) {
+          for (const auto& f : truth->frames) {
+            const auto it = runs[s].people.find(f.frame);
+            const auto score = eval::score_frame(
+                f, it == runs[s].people.end() ? std::vector<Box2D>{} : boxes(it->second), min_iou);
+            truths += score.truths, counted += score.detections, matched += score.matched;
+          }
+        }
+        std::vector<double> distances;
+        std::size_t people = 0;
+        for (const auto& [frame, found] : runs[s].people) {
+          people += found.size();
+          const auto ref = runs.front().people.find(frame);
+          if (ref != runs.front().people.end()) keypoint_distances(found, ref->second, distances);
+        }
+        const double recall = truths ? static_cast<double>(matched) / truths : std::nan("");
+        const double precision = counted ? static_cast<double>(matched) / counted : std::nan("");
+        const double per_frame = static_cast<double>(people) / std::max(1, runs[s].frames);
+        const double fps = runs[s].frames / std::max(1e-9, runs[s].seconds);
+        const double dist = median(distances);
+        std::printf("| %s | %.3f | %.3f | %d | %.1f | %.2f | %.1f |\n", names[s].c_str(), recall,
+                    precision, truths, dist, per_frame, fps);
+        rows.push_back({{"strategy", names[s]},
+                        {"recall", recall},
+                        {"precision", precision},
+                        {"true_people", truths},
+                        {"matched", matched},
+                        {"counted_detections", counted},
+                        {"median_keypoint_distance_px", dist},
+                        {"people_per_frame", per_frame},
+                        {"frames_per_second", fps},
+                        {"frames", runs[s].frames},
+                        {"seconds", runs[s].seconds}});
+      }
+      std::fflush(stdout);
+      report["inputs"].push_back({{"input", input}, {"rows", rows}});
+    }
+    if (args.has("json")) std::ofstream(args.get("json")) << report.dump(1) << "\n";
+  } catch (const std::exception& e) {
+    std::cerr << "mocap-bench-detect: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}

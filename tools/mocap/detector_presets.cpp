@@ -1,0 +1,46 @@
+#include "detector_presets.hpp"
+
+#include <stdexcept>
+
+namespace mocap::cli {
+
+const std::vector<DetectorPreset>& detector_presets() {
+  static const std::vector<DetectorPreset> presets = {
+      {"multipose",
+       "detect.movenet",
+       {{"input_size", "256"}},
+       "MoveNet MultiPose on the whole frame at 256 (at most 6 people)"},
+      {"multipose-512",
+       "detect.movenet",
+       {{"input_size", "512"}},
+       "MoveNet MultiPose at 512: smaller people, a quarter of the speed"},
+      {"tiles",
+       "detect.tiles",
+       {{"columns", "2"}, {"rows", "2"}, {"tile_input_size", "256"}, {"frame_input_size", "256"}},
+       "MultiPose on 2 x 2 overlapping tiles and the whole frame, merged"},
+      {"topdown",
+       "detect.topdown",
+       {{"pose_model", "lightning"}, {"detect_every", "10"}},
+       "CenterNet boxes every 10 frames, MoveNet Lightning per person on crops that follow them"},
+      {"topdown-thunder",
+       "detect.topdown",
+       {{"pose_model", "thunder"}, {"detect_every", "10"}},
+       "the same with MoveNet Thunder (256 px crops): better keypoints, slower"},
+  };
+  return presets;
+}
+
+std::string detector_names() {
+  std::string names;
+  for (const auto& p : detector_presets()) names += (names.empty() ? "" : ", ") + p.name;
+  return names;
+}
+
+const DetectorPreset& detector_preset(std::string_view name) {
+  for (const auto& p : detector_presets())
+    if (p.name == name) return p;
+  throw std::invalid_argument("unknown detector '" + std::string(name) + "'; choose one of " +
+                              detector_names());
+}
+
+}  // namespace mocap::cli
