@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <ctime>
+#include <sstream>
 #include <utility>
 
 namespace mocap::video {
@@ -23,6 +24,21 @@ Playback::Playback(std::string path, SourceOptions source_options, PlaybackOptio
       live_(options.live.value_or(source_.live())),
       paced_(live_ && !source_.live()),
       loop_(options.loop && !source_.live()) {}
+
+std::string Playback::describe() const {
+  std::ostringstream text;
+  text << name(source_.kind()) << " " << path_ << ", " << source_.width() << "x" << source_.height()
+       << ", " << source_.fps() << " fps, ";
+  if (source_.frame_count() >= 0)
+    text << source_.frame_count();
+  else
+    text << "unknown";
+  text << " frames, " << (live_ ? "live" : "offline");
+  if (source_options_.decoder_threads > 0 && !decoder_threads_supported())
+    text << " (decoder_threads ignored: this OpenCV's FFmpeg backend decodes with one thread per "
+            "core; OpenCV 4.7 can set it)";
+  return text.str();
+}
 
 double Playback::frame_period_s() const {
   return source_.fps() > 0 ? 1.0 / source_.fps() : 1.0 / 30.0;

@@ -43,6 +43,9 @@ class Playback {
   std::optional<StampedFrame> next(const WaitUntil& wait);
 
   const VideoSource& source() const { return source_; }
+  // For logs: "file PATH, WxH, F fps, N frames, offline", with a note when an option asked for
+  // cannot take effect here (decoder threads on OpenCV < 4.7).
+  std::string describe() const;
   bool live() const { return live_; }
   bool loops() const { return loop_; }
   std::uint64_t late_frames_passed_over() const { return late_; }

@@ -67,6 +67,8 @@ TEST(Playback, AFolderEndsAfterOnePassWithoutLoop) {
   while (playback.next(sleep_until)) ++frames;
   EXPECT_EQ(frames, 3);
   EXPECT_FALSE(playback.stopped());
+  EXPECT_NE(playback.describe().find("3 frames, offline"), std::string::npos)
+      << playback.describe();
 }
 
 TEST(Playback, APacedFolderIsStampedWhenItsFramesAreDue) {

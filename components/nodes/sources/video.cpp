@@ -56,17 +56,7 @@ class VideoSourceNode : public Node {
     camera_id_ = ctx.param<int>("camera");
     stream_ = ctx.param<std::string>("stream");
     if (stream_.empty()) stream_ = path;
-    if (options.decoder_threads > 0 && !video::decoder_threads_supported()) {
-      std::cerr << ctx.node_name()
-                << ": decoder_threads ignored: this OpenCV's FFmpeg backend decodes with one "
-                   "thread per core (OpenCV 4.7 can set it)\n";
-    }
-    const video::VideoSource& source = playback_->source();
-    std::cerr << ctx.node_name() << ": " << video::name(source.kind()) << " " << path << ", "
-              << source.width() << "x" << source.height() << ", " << source.fps() << " fps, "
-              << (source.frame_count() >= 0 ? std::to_string(source.frame_count())
-                                            : std::string("unknown"))
-              << " frames, " << (playback_->live() ? "live" : "offline") << "\n";
+    std::cerr << ctx.node_name() << ": " << playback_->describe() << "\n";
   }
 
   void process(Context& ctx) override {
