@@ -13,10 +13,10 @@
 
 #include <nlohmann/json.hpp>
 
-#include "detect/model_files.hpp"
 #include "support/files.hpp"
 #include "support/http_file_server.hpp"
 #include "support/mocap_process.hpp"
+#include "support/models.hpp"
 #include "support/network.hpp"
 #include "support/shared_data.hpp"
 
@@ -244,11 +244,7 @@ TEST_F(OutputIntegrityTest, OptionsThatContradictTheInputAreRefusedBeforeAnythin
 
 TEST_F(OutputIntegrityTest, AStreamThatStopsEarlyEndsTheRunLikeATruncatedFile) {
   if (!fs::exists(kVideo)) GTEST_SKIP() << "shared video absent: " << kVideo;
-  try {
-    detect::movenet_model_json();
-  } catch (const detect::ModelMissing&) {
-    GTEST_SKIP() << "MoveNet model absent: tools/setup.sh --models-only";
-  }
+  MOCAP_REQUIRE_MOVENET();
   const std::string bytes = test::read_file(kVideo.string());
   const test::HttpFileServer server(bytes, bytes.size() / 4);  // the connection lost at a quarter
   const std::string url = server.url("vtest_part0.avi");

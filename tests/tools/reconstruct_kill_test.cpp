@@ -16,10 +16,10 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/videoio.hpp>
 
-#include "detect/model_files.hpp"
 #include "motion/bvh.hpp"
 #include "support/files.hpp"
 #include "support/mocap_process.hpp"
+#include "support/models.hpp"
 #include "support/shared_data.hpp"
 
 namespace mocap {
@@ -32,15 +32,6 @@ const fs::path kCmu = test::shared_data() / "mocap" / "cmu31";
 const fs::path kJson = test::shared_data() / "eval" / "openpose_json" / "json";
 const fs::path kVideo = test::shared_data() / "eval" / "opencv_samples" / "vtest_part0.avi";
 constexpr std::size_t kJsonFrames = 120;  // more than the 64 frames an overlay once held back
-
-bool model_present() {
-  try {
-    detect::movenet_model_json();
-    return true;
-  } catch (const detect::ModelMissing&) {
-    return false;
-  }
-}
 
 // Complete lines of a file (each ended by a newline); `cut_tail` tells whether bytes follow the
 // last newline.
@@ -201,7 +192,7 @@ TEST_F(ReconstructKillTest, AnInterruptedOpenPoseRunKeepsWholeFiles) {
 
 TEST_F(ReconstructKillTest, AnInterruptedVideoRunKeepsWholeFiles) {
   if (!fs::exists(kVideo)) GTEST_SKIP() << "shared video absent: " << kVideo;
-  if (!model_present()) GTEST_SKIP() << "MoveNet model absent: tools/setup.sh --models-only";
+  MOCAP_REQUIRE_MOVENET();
   for (const auto& [signal, lines] : kMoments)
     interrupt("video", kVideo.string(), {}, 200, signal, lines);
 }
@@ -211,7 +202,7 @@ TEST_F(ReconstructKillTest, AnInterruptedVideoRunKeepsWholeFiles) {
 TEST_F(ReconstructKillTest, TheOverlayHoldsEveryInputFrameForEveryFit) {
   const std::size_t video_frames = 100;  // more than the 64 frames an overlay once held back
   for (const std::string fit : {"off", "live", "full"}) {
-    if (fs::exists(kVideo) && model_present()) {
+    if (fs::exists(kVideo) && test::movenet_model_present()) {
       const std::string out = dir_->file("overlay_video_" + fit);
       test::Mocap run(
           *dir_, "overlay_video_" + fit,

@@ -11,10 +11,10 @@
 
 #include <nlohmann/json.hpp>
 
-#include "detect/model_files.hpp"
 #include "motion/bvh.hpp"
 #include "support/files.hpp"
 #include "support/mocap_process.hpp"
+#include "support/models.hpp"
 #include "support/shared_data.hpp"
 
 namespace mocap {
@@ -190,18 +190,9 @@ TEST_F(ReconstructRerunTest, WithForceTheFolderHoldsThisRunsFilesOnlyAndTheRepor
   EXPECT_TRUE(summary.at("completed").get<bool>());
 }
 
-bool model_present() {
-  try {
-    detect::movenet_model_json();
-    return true;
-  } catch (const detect::ModelMissing&) {
-    return false;
-  }
-}
-
 TEST_F(ReconstructRerunTest, ATruncatedVideoRerunIsRefusedOrWithForceKeepsOnlyWhatItWrote) {
   if (!fs::exists(kVideo)) GTEST_SKIP() << "shared video absent: " << kVideo;
-  if (!model_present()) GTEST_SKIP() << "MoveNet model absent: tools/setup.sh --models-only";
+  MOCAP_REQUIRE_MOVENET();
   const std::string cut = dir_->file("cut.avi");
   const std::string bytes = test::read_file(kVideo.string());
   test::write_file(cut, bytes.substr(0, bytes.size() / 10));

@@ -7,8 +7,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "detect/model_files.hpp"
 #include "support/mocap_process.hpp"
+#include "support/models.hpp"
 #include "support/shared_data.hpp"
 #include "video/video_source.hpp"
 
@@ -47,17 +47,8 @@ class ReconstructVideoTest : public ::testing::Test {
   static inline std::unique_ptr<test::TempDir> dir_;
 };
 
-bool model_present() {
-  try {
-    detect::movenet_model_json();
-    return true;
-  } catch (const detect::ModelMissing&) {
-    return false;
-  }
-}
-
 TEST_F(ReconstructVideoTest, AVideoBecomesPosesBvhAndAnOverlayVideo) {
-  if (!model_present()) GTEST_SKIP() << "MoveNet model absent: tools/setup.sh --models-only";
+  MOCAP_REQUIRE_MOVENET();
   auto run =
       reconstruct("out", kVideo.string(),
                   {"--detector", "multipose", "--detector-size", "384", "--set", "src.count=30"});
@@ -118,7 +109,7 @@ TEST_F(ReconstructVideoTest, AMissingModelNamesTheSetupCommand) {
 }
 
 TEST_F(ReconstructVideoTest, ATruncatedVideoEndsWithAnErrorNamingIt) {
-  if (!model_present()) GTEST_SKIP() << "MoveNet model absent: tools/setup.sh --models-only";
+  MOCAP_REQUIRE_MOVENET();
   const std::string cut = dir_->file("cut.avi");
   const std::string bytes = test::read_file(kVideo.string());
   test::write_file(cut, bytes.substr(0, bytes.size() / 10));

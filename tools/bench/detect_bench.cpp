@@ -3,8 +3,9 @@
 // median keypoint distance to the reference strategy (the first listed), people per frame over
 // every frame, and frames/s end to end (decoding + detection, offline, every frame in order, so
 // that strategies that follow people between detector runs work as they would on the file). Each
-// strategy runs on each network runtime asked for (--backends: cv::dnn, XNNPACK). The networks'
-// forward time alone is mocap-bench-networks'.
+// strategy runs on each network runtime asked for (--backends: cv::dnn, XNNPACK). Top-down
+// strategies also get a table of where their time went (CenterNet, crops, keypoint passes). The
+// networks' forward time alone is mocap-bench-networks'.
 // Prints a Markdown table per input; --json writes every number.
 //
 // Also the tool that made the boxes: --candidates DIR writes the reference strategy's boxes on
@@ -49,6 +50,8 @@ struct Strategy {
   std::string name;
   std::function<People(const ImageBuffer&)> detect;
   std::function<void()> reset = [] {};
+  // Top-down only: where its time went (zero elsewhere).
+  std::function<detect::TopDownProfile()> profile = [] { return detect::TopDownProfile{}; };
 };
 
 std::vector<std::string> split(const std::string& text, char sep) {
@@ -59,7 +62,8 @@ std::vector<std::string> split(const std::string& text, char sep) {
   return out;
 }
 
-// multipose:SIZE | tiles:CxR:TILE:FRAME | topdown:lightning|thunder:EVERY, on `backend`.
+// multipose:SIZE | tiles:CxR:TILE:FRAME | topdown:lightning|thunder:EVERY[:WORKERS[:THREADS]],
+// on `backend`; a top-down spec's own THREADS replaces `threads`.
 Strategy make_strategy(const std::string& spec, detect::Backend backend, int threads) {
   const auto parts = split(spec, ':');
   if (parts.size() == 2 && parts[0] == "multipose") {
@@ -83,22 +87,27 @@ Strategy make_strategy(const std::string& spec, detect::Backend backend, int thr
     auto d = std::make_shared<detect::TiledDetector>(detect::movenet_model_json(), o);
     return {spec, [d](const ImageBuffer& f) { return d->detect(f); }};
   }
-  if (parts.size() == 3 && parts[0] == "topdown") {
+  if (parts.size() >= 3 && parts.size() <= 5 && parts[0] == "topdown") {
     detect::TopDownOptions o;
     if (parts[1] != "lightning" && parts[1] != "thunder")
-      throw std::invalid_argument("topdown:lightning|thunder:EVERY, got " + spec);
+      throw std::invalid_argument("topdown:lightning|thunder:EVERY[:WORKERS[:THREADS]], got " +
+                                  spec);
     o.pose_model = parts[1] == "thunder" ? detect::SinglePoseModel::thunder
                                          : detect::SinglePoseModel::lightning;
     o.detect_every = std::stoi(parts[2]);
     o.backend = backend;
-    o.threads = threads;
+    o.threads = parts.size() == 5 ? std::stoi(parts[4]) : threads;
+    o.workers = parts.size() >= 4 ? std::stoi(parts[3]) : 1;
     auto d = std::make_shared<detect::TopDownDetector>(
         o, detect::cached_model_json(detect::model_name(o.pose_model)),
         detect::cached_model_json("centernet"));
-    return {spec, [d](const ImageBuffer& f) { return d->detect(f); }, [d] { d->reset(); }};
+    d->warm_up();
+    return {spec, [d](const ImageBuffer& f) { return d->detect(f); }, [d] { d->reset(); },
+            [d] { return d->profile(); }};
   }
   throw std::invalid_argument("unknown strategy '" + spec +
-                              "' (multipose:SIZE, tiles:CxR:TILE:FRAME, topdown:MODEL:EVERY)");
+                              "' (multipose:SIZE, tiles:CxR:TILE:FRAME, "
+                              "topdown:MODEL:EVERY[:WORKERS[:THREADS]])");
 }
 
 // Every frame of a video, or the one image of a still.
@@ -136,7 +145,16 @@ struct Run {
   std::map<int, People> people;  // every frame
   double seconds = 0;
   int frames = 0;
+  detect::TopDownProfile profile;  // of the timed frames (top-down only)
 };
+
+detect::TopDownProfile minus(detect::TopDownProfile a, const detect::TopDownProfile& b) {
+  a.frames -= b.frames, a.detector_runs -= b.detector_runs, a.crops -= b.crops;
+  a.total -= b.total, a.centernet -= b.centernet, a.crop_fill -= b.crop_fill;
+  a.centernet_wait -= b.centernet_wait;
+  a.keypoints -= b.keypoints;
+  return a;
+}
 
 // Every frame in order, or only those in `only` (sorted; empty: all).
 Run run(Strategy& s, const std::string& input, const std::vector<int>& only) {
@@ -149,6 +167,7 @@ Run run(Strategy& s, const std::string& input, const std::vector<int>& only) {
     s.reset();
   }
   Frames frames(input);
+  const detect::TopDownProfile before = s.profile();
   const auto start = Clock::now();
   for (int i = 0;; ++i) {
     auto f = frames.next();
@@ -158,6 +177,7 @@ Run run(Strategy& s, const std::string& input, const std::vector<int>& only) {
     ++r.frames;
   }
   r.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  r.profile = minus(s.profile(), before);
   return r;
 }
 
@@ -259,6 +279,31 @@ json candidates(const std::string& input, const Run& reference, const std::vecto
   return {{"input", input}, {"min_height", min_height}, {"frames", frames}};
 }
 
+// Where the top-down strategies' time went, in ms per frame.
+void print_profiles(const std::vector<std::string>& names, const std::vector<Run>& runs) {
+  bool header = false;
+  for (std::size_t s = 0; s < runs.size(); ++s) {
+    const detect::TopDownProfile& p = runs[s].profile;
+    if (p.frames == 0) continue;
+    if (!header)
+      std::printf(
+          "\n| top-down strategy | crops/frame | detector runs | ms/frame: detect() | "
+          "CenterNet (per run; on the caller) | crop cutting | keypoint passes (per crop) | rest "
+          "|\n"
+          "|---|---|---|---|---|---|---|---|\n");
+    header = true;
+    const double f = static_cast<double>(p.frames);
+    const double rest = p.total - p.centernet_wait - p.crop_fill - p.keypoints;
+    std::printf(
+        "| %s | %.2f | %lld | %.1f | %.1f (%.1f; %.1f waited) | %.1f | %.1f (%.2f) | %.1f |\n",
+        names[s].c_str(), static_cast<double>(p.crops) / f, p.detector_runs, 1e3 * p.total / f,
+        1e3 * p.centernet / f,
+        p.detector_runs ? 1e3 * p.centernet / static_cast<double>(p.detector_runs) : 0.0,
+        1e3 * p.centernet_wait / f, 1e3 * p.crop_fill / f, 1e3 * p.keypoints / f,
+        p.crops ? 1e3 * p.keypoints / static_cast<double>(p.crops) : 0.0, 1e3 * rest / f);
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -276,7 +321,9 @@ int main(int argc, char** argv) {
       .option("strategies", "LIST",
               "the first (on the first runtime) is the reference for keypoint distances: "
               "multipose:SIZE, "
-              "tiles:CxR:TILE:FRAME, topdown:lightning|thunder:EVERY",
+              "tiles:CxR:TILE:FRAME, topdown:lightning|thunder:EVERY[:WORKERS[:THREADS]] "
+              "(workers: copies of the keypoint network sharing a frame's crops; a top-down "
+              "strategy also prints where its time went)",
               "topdown:thunder:1,multipose:256,multipose:512,tiles:2x2:256:256,"
               "topdown:lightning:1,topdown:lightning:10,topdown:thunder:10")
       .option("truth", "DIR", "hand-checked boxes", "tests/data/detection")
@@ -380,6 +427,7 @@ int main(int argc, char** argv) {
                         {"frames", runs[s].frames},
                         {"seconds", runs[s].seconds}});
       }
+      print_profiles(names, runs);
       std::fflush(stdout);
       report["inputs"].push_back({{"input", input}, {"rows", rows}});
     }

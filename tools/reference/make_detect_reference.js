@@ -11,11 +11,9 @@
 // --models-only), FRAME.png is vtest-f300.png (../shared/docs/models/movenet-multipose/).
 'use strict';
 
-const crypto = require('crypto');
 const fs = require('fs');
 const path = require('path');
-const tf = require('@tensorflow/tfjs');
-const { PNG } = require('pngjs');
+const { tf, sha256, readRgb, cutWindow, loadGraphModel, maxDiff, parseArgs, writeAndCheck } = require('./tfjs_common');
 
 const SP = 'StatefulPartitionedCall';
 const SINGLE_HEADS = [`${SP}/center_0/conv2d_4/BiasAdd`, `${SP}/kpt_heatmap_0/conv2d_5/BiasAdd`,
@@ -31,36 +29,12 @@ const CASES = [
   { id: 'centernet_vtest_f300_x0_y0', model: 'centernet', x: 0, y: 0, size: 512 },
 ];
 
-const sha256 = (bytes) => crypto.createHash('sha256').update(bytes).digest('hex');
-
-function readRgb(file) {
-  const png = PNG.sync.read(fs.readFileSync(file));
-  const rgb = Buffer.alloc(png.width * png.height * 3);
-  for (let i = 0; i < png.width * png.height; ++i) png.data.copy(rgb, 3 * i, 4 * i, 4 * i + 3);
-  return { width: png.width, height: png.height, rgb };
-}
-
-function window(frame, c) {
-  if (c.x + c.size > frame.width || c.y + c.size > frame.height) throw new Error(`${c.id}: outside the frame`);
-  const out = Buffer.alloc(c.size * c.size * 3);
-  for (let r = 0; r < c.size; ++r) {
-    frame.rgb.copy(out, r * c.size * 3, ((c.y + r) * frame.width + c.x) * 3, ((c.y + r) * frame.width + c.x + c.size) * 3);
-  }
-  return out;
-}
 
 async function loadModel(root, name) {
   const dir = path.join(root, name);
-  const json = JSON.parse(fs.readFileSync(path.join(dir, `${name}.json`), 'utf8'));
-  const bin = fs.readFileSync(path.join(dir, `${name}.bin`));
-  const weightData = bin.buffer.slice(bin.byteOffset, bin.byteOffset + bin.byteLength);
-  const model = await tf.loadGraphModel(tf.io.fromMemory({
-    modelTopology: json.modelTopology, weightSpecs: json.weightsManifest[0].weights, weightData,
-    format: json.format, generatedBy: json.generatedBy, convertedBy: json.convertedBy,
-  }));
-  return { model, generatedBy: json.generatedBy, sha256: {
-    [`models/${name}.json`]: sha256(fs.readFileSync(path.join(dir, `${name}.json`))),
-    [`models/${name}.bin`]: sha256(bin) } };
+  const m = await loadGraphModel(path.join(dir, `${name}.json`), path.join(dir, `${name}.bin`));
+  return { model: m.model, generatedBy: m.json.generatedBy,
+    sha256: { [`models/${name}.json`]: m.jsonSha256, [`models/${name}.bin`]: m.binSha256 } };
 }
 
 // min / max / mean over the NHWC tensor and, per listed cell (y, x), all its channels.
@@ -94,27 +68,15 @@ function runCenternet(m, rgb, c) {
     heads: CENTERNET_HEADS.map((name, i) => summary(name, outs[1 + i], cells)) };
 }
 
-function maxDiff(a, b) {
-  if (typeof a === 'number' && typeof b === 'number') return Math.abs(a - b);
-  if (Array.isArray(a) && Array.isArray(b) && a.length === b.length)
-    return a.reduce((m, v, i) => Math.max(m, maxDiff(v, b[i])), 0);
-  if (a && b && typeof a === 'object' && typeof b === 'object')
-    return Object.keys(a).reduce((m, k) => (k in b ? Math.max(m, maxDiff(a[k], b[k])) : m), 0);
-  return a === b || typeof a === 'string' ? 0 : Infinity;
-}
-
 async function main() {
-  const [modelRoot, framePng, out, flag, old] = process.argv.slice(2);
-  if (!out || (flag && flag !== '--check')) {
-    console.error('usage: make_detect_reference.js MODEL_ROOT FRAME.png OUT.json [--check OLD.json]');
-    process.exit(2);
-  }
+  const { first: modelRoot, second: framePng, out, old } =
+    parseArgs('make_detect_reference.js MODEL_ROOT FRAME.png OUT.json [--check OLD.json]');
   await tf.setBackend('cpu');
   const frame = readRgb(framePng);
   const models = {};
   for (const name of new Set(CASES.map((c) => c.model))) models[name] = await loadModel(modelRoot, name);
   const cases = CASES.map((c) => {
-    const rgb = window(frame, c);
+    const rgb = cutWindow(frame, c);
     const m = models[c.model];
     const result = c.model === 'centernet' ? runCenternet(m, rgb, c) : runSingle(m, rgb, c);
     return { id: c.id, model: c.model, window_x_y_size: [c.x, c.y, c.size], input_rgb_bytes_sha256: sha256(rgb),
@@ -131,17 +93,7 @@ async function main() {
     windows: 'the RGB pixels of frame rows y..y+size-1, columns x..x+size-1, unchanged',
     cases,
   };
-  fs.writeFileSync(out, JSON.stringify(reference, null, 1) + '\n');
-  console.log(`wrote ${out}`);
-  if (flag === '--check') {
-    const before = JSON.parse(fs.readFileSync(old, 'utf8'));
-    for (const c of cases) {
-      const o = before.cases.find((b) => b.id === c.id);
-      const d = o ? maxDiff(c, o) : Infinity;
-      console.log(`${c.id}: max |difference| to ${old}: ${d}`);
-      if (!(d <= 1e-5)) process.exitCode = 1;
-    }
-  }
+  writeAndCheck(reference, out, old, maxDiff);
 }
 
 main().catch((e) => { console.error(e.message || e); process.exit(1); });

