@@ -28,6 +28,9 @@ namespace fs = std::filesystem;
 const fs::path kFrame =
     fs::path("..") / "shared" / "docs" / "models" / "movenet-multipose" / "vtest-f300.png";
 
+// The rig name of the camera the frames come from: the detectors' people must say it.
+const std::string kCamera = "cam_left";
+
 // unit.image_file: one PNG sent `count` times as bgr8 frames.
 class ImageFileSource : public Node {
  public:
@@ -48,6 +51,7 @@ class ImageFileSource : public Node {
     if (sent_ == count_) return ctx.finish();
     VideoFrame frame;
     frame.header = {"camera0", static_cast<std::uint64_t>(sent_), 1000 + sent_, sent_};
+    frame.camera = kCamera;
     frame.image =
         ImageBuffer(image_->cols, image_->rows, static_cast<int>(image_->step[0]),
                     PixelFormat::bgr8, image_, reinterpret_cast<const std::byte*>(image_->data));
@@ -108,6 +112,7 @@ TEST(MovenetNode, SendsCoco17PeopleInFramePixelsWithTheFrameHeaders) {
     const People2D& people = captured[i];
     EXPECT_EQ(people.header.frame, static_cast<std::int64_t>(i));
     EXPECT_EQ(people.header.capture_ns, 1000 + static_cast<std::int64_t>(i));
+    EXPECT_EQ(people.camera, kCamera);
     EXPECT_EQ(people.layout, LayoutId::coco17);
     ASSERT_EQ(people.people.size(), 6u);  // the six pedestrians (scores 0.36 .. 0.21)
     for (const Person2D& p : people.people) {
@@ -216,6 +221,7 @@ TEST(TopDownNode, FindsMoreThanSixPeopleInFramePixelsOnBothRuntimes) {
     for (std::size_t i = 0; i < captured.size(); ++i) {
       const People2D& people = captured[i];
       EXPECT_EQ(people.header.frame, static_cast<std::int64_t>(i));
+      EXPECT_EQ(people.camera, kCamera);
       EXPECT_EQ(people.layout, LayoutId::coco17);
       EXPECT_GT(people.people.size(), 6u);
       int left = 0, right = 0;
@@ -243,6 +249,7 @@ TEST(TilesNode, FindsMoreThanSixPeopleOnBothRuntimes) {
         "detect.tiles", /*copies=*/2));
     ASSERT_TRUE(result.ok) << result.error;
     ASSERT_EQ(captured.size(), 2u);
+    EXPECT_EQ(captured[0].camera, kCamera);
     EXPECT_GT(captured[0].people.size(), 6u);
   }
 }

@@ -59,8 +59,9 @@ class MovenetNode : public Node {
   }
 
   void process(Context& ctx) override {
-    headers_.push_back(ctx.header());
-    for (auto& people : workers_->push(ctx.input<VideoFrame>("in").image)) send(ctx, people);
+    const auto& frame = ctx.input<VideoFrame>("in");
+    frames_.push_back({ctx.header(), frame.camera});
+    for (auto& people : workers_->push(frame.image)) send(ctx, people);
   }
 
   void close(Context& ctx) override {
@@ -69,16 +70,20 @@ class MovenetNode : public Node {
   }
 
  private:
-  // The oldest frame's people, with that frame's header.
+  // The oldest frame's people, with that frame's header and camera.
   void send(Context& ctx, const std::vector<detect::MovenetPerson>& found) {
-    People2D out = to_people2d(found);
-    out.header = headers_.front();
-    headers_.pop_front();
+    People2D out = to_people2d(found, frames_.front().camera);
+    out.header = frames_.front().header;
+    frames_.pop_front();
     ctx.send("out", std::move(out));
   }
 
   std::optional<detect::MovenetWorkers> workers_;
-  std::deque<Header> headers_;  // of the frames in work, oldest first
+  struct FrameInWork {
+    Header header;
+    std::string camera;
+  };
+  std::deque<FrameInWork> frames_;  // oldest first
 };
 
 MOCAP_REGISTER_NODE("detect.movenet", MovenetNode)

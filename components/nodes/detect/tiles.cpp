@@ -54,7 +54,8 @@ class TilesNode : public Node {
   }
 
   void process(Context& ctx) override {
-    ctx.send("out", to_people2d(detector_->detect(ctx.input<VideoFrame>("in").image)));
+    const auto& frame = ctx.input<VideoFrame>("in");
+    ctx.send("out", to_people2d(detector_->detect(frame.image), frame.camera));
   }
 
  private:
