@@ -3,7 +3,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
+#include <string>
+#include <vector>
 
 #include "core/input_error.hpp"
 #include "eval/detection_truth.hpp"
@@ -64,6 +67,59 @@ TEST(DetectionTruth, MatchesBestFirstEachTruthOnceAndIgnoresTheIgnored) {
   EXPECT_EQ(s.match, (std::vector<int>{0, -1, -2, -1}));
   // Below the IoU the detection does not count as found.
   EXPECT_EQ(score_frame(f, {{10, 30, 20, 60}}, 0.5f).matched, 0);
+}
+
+// The hand-checked files themselves (tests/data/detection/README.md): every box lies in the frame,
+// every counted person is at least min_height tall unless the frame's border cuts them, and
+// vtest_part0.json (the first 200 frames of vtest.avi) holds exactly the truth of vtest.json there.
+TEST(DetectionTruth, CommittedFilesAreConsistent) {
+  const std::filesystem::path dir = "tests/data/detection";
+  if (!std::filesystem::is_directory(dir)) GTEST_SKIP() << dir << " is absent";
+  int files = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    if (entry.path().extension() != ".json" || entry.path().filename() == "tfjs_reference.json")
+      continue;
+    ++files;
+    const DetectionTruth t = read_detection_truth(entry.path());
+    for (const TruthFrame& f : t.frames) {
+      const std::string where =
+          entry.path().filename().string() + " frame " + std::to_string(f.frame);
+      for (const auto* boxes : {&f.people, &f.ignore}) {
+        for (const Box2D& b : *boxes) {
+          EXPECT_TRUE(b.x >= 0 && b.y >= 0 && b.x + b.width <= t.width &&
+                      b.y + b.height <= t.height)
+              << where << ": a box leaves the " << t.width << "x" << t.height << " frame";
+        }
+      }
+      for (const Box2D& b : f.people) {
+        const bool cut =
+            b.x <= 0 || b.y <= 0 || b.x + b.width >= t.width || b.y + b.height >= t.height;
+        EXPECT_TRUE(cut || b.height >= t.min_height)
+            << where << ": a person " << b.height << " px tall belongs in 'ignore'";
+      }
+    }
+  }
+  EXPECT_GE(files, 1);
+
+  if (!std::filesystem::exists(dir / "vtest.json") ||
+      !std::filesystem::exists(dir / "vtest_part0.json"))
+    return;
+  const DetectionTruth whole = read_detection_truth(dir / "vtest.json");
+  const DetectionTruth part = read_detection_truth(dir / "vtest_part0.json");
+  std::vector<const TruthFrame*> early;
+  for (const TruthFrame& f : whole.frames)
+    if (f.frame < 200) early.push_back(&f);
+  ASSERT_EQ(part.frames.size(), early.size());
+  const auto same = [](const std::vector<Box2D>& a, const std::vector<Box2D>& b) {
+    return std::equal(a.begin(), a.end(), b.begin(), b.end(), [](const Box2D& p, const Box2D& q) {
+      return p.x == q.x && p.y == q.y && p.width == q.width && p.height == q.height;
+    });
+  };
+  for (std::size_t i = 0; i < early.size(); ++i) {
+    EXPECT_EQ(part.frames[i].frame, early[i]->frame);
+    EXPECT_TRUE(same(part.frames[i].people, early[i]->people)) << "frame " << early[i]->frame;
+    EXPECT_TRUE(same(part.frames[i].ignore, early[i]->ignore)) << "frame " << early[i]->frame;
+  }
 }
 
 }  // namespace
