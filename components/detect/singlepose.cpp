@@ -139,26 +139,38 @@ const std::vector<GraphTensor>& SinglePoseNetwork::run_heads(const GraphTensor& 
 }
 
 std::vector<SinglePoseKeypoints> SinglePoseNetwork::run(const GraphTensor& crops) {
+  const int batch = crops.shape.empty() ? 0 : static_cast<int>(crops.shape[0]);
+  std::vector<SinglePoseKeypoints> out(static_cast<std::size_t>(std::max(batch, 0)));
+  run(crops, 0, batch, out);
+  return out;
+}
+
+void SinglePoseNetwork::run(const GraphTensor& crops, int first, int count,
+                            std::span<SinglePoseKeypoints> out) {
   constexpr int kLargestPass = 8;
   if (crops.shape.size() != 4 || crops.values.size() != crops.size())
     throw std::invalid_argument(std::string(model_name(model_)) + ": malformed crop batch");
   const int batch = static_cast<int>(crops.shape[0]);
+  if (first < 0 || count < 0 || first + count > batch ||
+      out.size() < static_cast<std::size_t>(count))
+    throw std::invalid_argument(std::string(model_name(model_)) + ": crops " +
+                                std::to_string(first) + " + " + std::to_string(count) +
+                                " outside the batch of " + std::to_string(batch));
   const std::size_t per_crop = batch > 0 ? crops.size() / static_cast<std::size_t>(batch) : 0;
-  std::vector<SinglePoseKeypoints> out;
-  out.reserve(static_cast<std::size_t>(std::max(batch, 0)));
-  for (int done = 0; done < batch;) {
+  for (int done = 0; done < count;) {
     int pass = kLargestPass;
-    while (pass > batch - done) pass /= 2;
+    while (pass > count - done) pass /= 2;
     pass_.shape = crops.shape;
     pass_.shape[0] = pass;
-    const auto first = crops.values.begin() + static_cast<std::ptrdiff_t>(done * per_crop);
-    pass_.values.assign(first, first + static_cast<std::ptrdiff_t>(pass * per_crop));
+    const auto begin =
+        crops.values.begin() + static_cast<std::ptrdiff_t>((first + done) * per_crop);
+    pass_.values.assign(begin, begin + static_cast<std::ptrdiff_t>(pass * per_crop));
     const std::vector<GraphTensor>& heads = run_heads(pass_);
     for (int n = 0; n < pass; ++n)
-      out.push_back(decode_singlepose(heads[0], heads[1], heads[2], heads[3], n));
+      out[static_cast<std::size_t>(done + n)] =
+          decode_singlepose(heads[0], heads[1], heads[2], heads[3], n);
     done += pass;
   }
-  return out;
 }
 
 }  // namespace mocap::detect

@@ -59,6 +59,8 @@ class SinglePoseNetwork {
   // runtime builds itself per input shape (about 0.3 s) and keeps the last 4, so whatever the
   // number of people, these four shapes are all it ever builds.
   std::vector<SinglePoseKeypoints> run(const GraphTensor& crops);
+  // The same for crops [first, first + count) of the batch, written to out[0, count).
+  void run(const GraphTensor& crops, int first, int count, std::span<SinglePoseKeypoints> out);
 
  private:
   SinglePoseModel model_;

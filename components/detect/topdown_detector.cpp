@@ -1,7 +1,9 @@
 #include "detect/topdown_detector.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <exception>
 #include <stdexcept>
 #include <string>
 
@@ -15,6 +17,12 @@ namespace {
 // How far above the eyes the head reaches, as a share of the keypoints' extent.
 constexpr float kHeadMargin = 0.12f;
 
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
 void check(const TopDownOptions& o) {
   if (o.detect_every < 1) throw std::invalid_argument("detect_every must be at least 1");
   if (!(o.crop_padding >= 1.0f && o.crop_padding <= 4.0f))
@@ -22,17 +30,32 @@ void check(const TopDownOptions& o) {
   if (o.min_keypoints < 1 || o.min_keypoints > kMovenetKeypoints)
     throw std::invalid_argument("min_keypoints must lie in [1, 17]");
   if (o.detector_tiles < 1) throw std::invalid_argument("detector_tiles must be at least 1");
+  if (o.workers < 1 || o.workers > 16) throw std::invalid_argument("workers must lie in [1, 16]");
 }
 
 RunnerOptions runner_options(const TopDownOptions& o) {
   RunnerOptions r;
   r.backend = o.backend;
-  r.threads = o.threads;
+  // Several copies of a network each on a pool of all cores would fight over them.
+  r.threads = o.threads == 0 && o.workers > 1 ? 1 : o.threads;
   return r;
 }
 
 Box2D moved(const Box2D& box, float dx, float dy) {
   return {box.x + dx, box.y + dy, box.width, box.height};
+}
+
+// Waits for the `count` oldest jobs of `helpers`, then rethrows the first error (`error`, then
+// theirs): jobs refer to the caller's locals, so none may still run when it unwinds.
+void join(OrderedWorkers<int>& helpers, int count, std::exception_ptr error) {
+  for (int i = 0; i < count; ++i) {
+    try {
+      helpers.next(true);
+    } catch (...) {
+      if (!error) error = std::current_exception();
+    }
+  }
+  if (error) std::rethrow_exception(error);
 }
 
 }  // namespace
@@ -41,8 +64,12 @@ TopDownDetector::TopDownDetector(const TopDownOptions& options,
                                  const std::filesystem::path& pose_model_json,
                                  const std::filesystem::path& centernet_json)
     : options_((check(options), options)),
-      pose_(options.pose_model, pose_model_json, runner_options(options)),
-      boxes_(std::make_unique<CenternetNetwork>(centernet_json, runner_options(options))) {}
+      boxes_(std::make_unique<CenternetNetwork>(centernet_json, runner_options(options))) {
+  for (int i = 0; i < options_.workers; ++i)
+    poses_.push_back(std::make_unique<SinglePoseNetwork>(options_.pose_model, pose_model_json,
+                                                         runner_options(options_)));
+  if (options_.workers > 1) helpers_ = std::make_unique<OrderedWorkers<int>>(options_.workers - 1);
+}
 
 TopDownDetector::~TopDownDetector() = default;
 
@@ -52,32 +79,81 @@ void TopDownDetector::reset() {
   lost_someone_ = false;
 }
 
-std::vector<Detection> TopDownDetector::find_boxes(const ImageBuffer& frame) {
-  ++detector_runs_;
-  return propose_people(*boxes_, frame,
-                        {options_.min_box_score, options_.box_overlap, options_.detector_tiles},
-                        image_);
+void TopDownDetector::warm_up() {
+  image_batch(image_, 1, kCenternetInput, kCenternetInput);
+  boxes_->run(image_);
+  // The shapes SinglePoseNetwork::run passes: 8, 4, 2 and 1 crops, on every copy.
+  const int copies = static_cast<int>(poses_.size());
+  const int size = poses_.front()->input_size();
+  for (const int pass : {8, 4, 2, 1}) {
+    image_batch(crops_, pass * copies, size, size);
+    found_.resize(static_cast<std::size_t>(pass * copies));
+    run_keypoints(0, pass * copies, copies);
+  }
+  found_.clear();
 }
 
-std::vector<MovenetPerson> TopDownDetector::pose(const ImageBuffer& frame,
-                                                 const std::vector<Box2D>& boxes) {
-  std::vector<MovenetPerson> people;
-  if (boxes.empty()) return people;
-  const int size = pose_.input_size();
-  image_batch(crops_, static_cast<int>(boxes.size()), size, size);
-  std::vector<SquareRegion> regions;
-  for (std::size_t i = 0; i < boxes.size(); ++i) {
-    regions.push_back(square_around(boxes[i], options_.crop_padding));
-    fill_region(frame, regions.back(), crops_, static_cast<int>(i));
+std::vector<Detection> TopDownDetector::find_boxes(const ImageBuffer& frame) {
+  const auto start = Clock::now();
+  std::vector<Detection> found = propose_people(
+      *boxes_, frame, {options_.min_box_score, options_.box_overlap, options_.detector_tiles},
+      image_);
+  ++profile_.detector_runs;
+  profile_.centernet += seconds_since(start);
+  return found;
+}
+
+void TopDownDetector::run_keypoints(int first, int count, int copies) {
+  copies = std::clamp(copies, 1, std::max(count, 1));
+  const std::span<SinglePoseKeypoints> out(found_.data() + first, static_cast<std::size_t>(count));
+  // Copy c takes crops [count c / copies, count (c + 1) / copies).
+  const auto share = [&](int c) {
+    const int begin = count * c / copies, end = count * (c + 1) / copies;
+    poses_[static_cast<std::size_t>(c)]->run(crops_, begin, end - begin,
+                                             out.subspan(static_cast<std::size_t>(begin)));
+  };
+  for (int c = 1; c < copies; ++c)
+    helpers_->submit([&share, c](int) {
+      share(c);
+      return 0;
+    });
+  std::exception_ptr error;
+  try {
+    share(0);
+  } catch (...) {
+    error = std::current_exception();
   }
-  const std::vector<SinglePoseKeypoints> found = pose_.run(crops_);
-  for (std::size_t i = 0; i < found.size(); ++i) {
-    const SquareRegion& r = regions[i];
+  if (copies > 1) join(*helpers_, copies - 1, error);
+  if (error) std::rethrow_exception(error);
+}
+
+void TopDownDetector::add_crops(const ImageBuffer& frame, std::span<const Box2D> boxes,
+                                int copies) {
+  if (boxes.empty()) return;
+  auto start = Clock::now();
+  const int count = static_cast<int>(boxes.size());
+  const int size = poses_.front()->input_size();
+  image_batch(crops_, count, size, size);
+  const int first = static_cast<int>(found_.size());
+  for (int i = 0; i < count; ++i) {
+    regions_.push_back(square_around(boxes[static_cast<std::size_t>(i)], options_.crop_padding));
+    fill_region(frame, regions_.back(), crops_, i);
+  }
+  found_.resize(found_.size() + boxes.size());
+  profile_.crop_fill += seconds_since(start);
+  start = Clock::now();
+  run_keypoints(first, count, copies);
+  profile_.keypoints += seconds_since(start);
+}
+std::vector<MovenetPerson> TopDownDetector::people_found() const {
+  std::vector<MovenetPerson> people;
+  for (std::size_t i = 0; i < found_.size(); ++i) {
+    const SquareRegion& r = regions_[i];
     MovenetPerson person;
     int passing = 0;
     float sum = 0;
     for (int k = 0; k < kMovenetKeypoints; ++k) {
-      const auto& [y, x, score] = found[i][k];
+      const auto& [y, x, score] = found_[i][k];
       Keypoint2D& out = person.keypoints[k];
       if (score >= options_.min_keypoint_score) {
         out = {r.cx - r.side / 2 + x * r.side, r.cy - r.side / 2 + y * r.side, score};
@@ -97,21 +173,49 @@ std::vector<MovenetPerson> TopDownDetector::pose(const ImageBuffer& frame,
 }
 
 std::vector<MovenetPerson> TopDownDetector::detect(const ImageBuffer& frame) {
+  const auto start = Clock::now();
   // Where each followed person should be now.
   std::vector<Box2D> boxes;
   for (const Followed& f : followed_) boxes.push_back(moved(f.box, f.vx, f.vy));
   const bool run_detector =
       frame_ % options_.detect_every == 0 || lost_someone_ || followed_.empty();
+  ++frame_;
+  regions_.clear();
+  found_.clear();
+  const int copies = static_cast<int>(poses_.size());
+  std::size_t cropped = 0;  // boxes whose keypoints are found
   if (run_detector) {
-    for (const Detection& d : find_boxes(frame)) {
+    std::vector<Detection> detections;
+    if (helpers_) {
+      // The person detector on a helper, the followed people's crops here meanwhile.
+      helpers_->submit([&](int) {
+        detections = find_boxes(frame);
+        return 0;
+      });
+      std::exception_ptr error;
+      try {
+        add_crops(frame, boxes, 1);
+      } catch (...) {
+        error = std::current_exception();
+      }
+      const auto waiting = Clock::now();
+      join(*helpers_, 1, error);
+      profile_.centernet_wait += seconds_since(waiting);
+      cropped = boxes.size();
+    } else {
+      const auto running = Clock::now();
+      detections = find_boxes(frame);
+      profile_.centernet_wait += seconds_since(running);
+    }
+    for (const Detection& d : detections) {
       const bool followed = std::any_of(boxes.begin(), boxes.end(), [&](const Box2D& b) {
         return iou(b, d.box) > options_.followed_overlap;
       });
       if (!followed) boxes.push_back(d.box);
     }
   }
-  ++frame_;
-  std::vector<MovenetPerson> people = pose(frame, boxes);
+  add_crops(frame, std::span<const Box2D>(boxes).subspan(cropped), copies);
+  std::vector<MovenetPerson> people = people_found();
 
   // The next frame's crops: each person's box, moved by how far their nearest predecessor moved.
   std::vector<Followed> next;
@@ -132,6 +236,9 @@ std::vector<MovenetPerson> TopDownDetector::detect(const ImageBuffer& frame) {
   }
   lost_someone_ = next.size() < followed_.size() && !run_detector;
   followed_ = std::move(next);
+  ++profile_.frames;
+  profile_.crops += static_cast<long long>(boxes.size());
+  profile_.total += seconds_since(start);
   return people;
 }
 

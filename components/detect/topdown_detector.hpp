@@ -6,14 +6,22 @@
 // pose pipeline and of rtmlib's PoseTracker. A person whose crop no longer shows one is dropped,
 // and the detector then runs on the next frame to look for them and for newcomers. No cap on the
 // number of people.
+//
+// Both cores: `workers` single-thread copies of the keypoint network share each frame's crops (a
+// share each, the calling thread runs one), and on a frame where the person detector runs it runs
+// on a helper thread while the calling thread does the crops of the people already followed
+// (measured against one two-thread network in docs/detection-strategies.md).
 
 #include <filesystem>
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "core/image_buffer.hpp"
 #include "detect/centernet.hpp"
+#include "detect/image_tensor.hpp"
 #include "detect/movenet_decoder.hpp"
+#include "detect/ordered_workers.hpp"
 #include "detect/singlepose.hpp"
 
 namespace mocap::detect {
@@ -41,6 +49,21 @@ struct TopDownOptions {
   // network's own, 0 meaning one; cv::dnn's are process-wide, 0 its default).
   Backend backend = Backend::automatic;
   int threads = 0;
+  // Copies of the keypoint network, each on its own thread (the calling thread runs the first);
+  // with more than one, `threads` 0 means 1 per copy.
+  int workers = 1;
+};
+
+// Where the time of detect() went, summed over the frames since the detector was made (seconds,
+// wall clock). CenterNet runs on a helper thread when there are several workers, then overlapping
+// the keypoint passes.
+struct TopDownProfile {
+  long long frames = 0, detector_runs = 0, crops = 0;
+  double total = 0;           // detect() from call to return
+  double centernet = 0;       // the person detector: frame stretched, forward, decoding, NMS
+  double centernet_wait = 0;  // the calling thread running it or waiting for its helper
+  double crop_fill = 0;       // crops cut out of the frame
+  double keypoints = 0;  // keypoint passes on the calling thread, waiting for the helpers included
 };
 
 class TopDownDetector {
@@ -54,12 +77,16 @@ class TopDownDetector {
   std::vector<MovenetPerson> detect(const ImageBuffer& frame);
   // Forget the people followed so far (a new video).
   void reset();
+  // Runs both networks once on blank inputs of every shape they will get (XNNPACK builds a
+  // runtime per shape, about 0.3 s each), so that a live source's first frames are not late.
+  void warm_up();
 
   const TopDownOptions& options() const { return options_; }
   // The runtime the networks run on (`automatic` resolved).
-  Backend backend() const { return pose_.backend(); }
+  Backend backend() const { return poses_.front()->backend(); }
   // Frames on which the person detector ran, of all frames seen.
-  long long detector_runs() const { return detector_runs_; }
+  long long detector_runs() const { return profile_.detector_runs; }
+  const TopDownProfile& profile() const { return profile_; }
 
  private:
   struct Followed {
@@ -67,15 +94,24 @@ class TopDownDetector {
     float vx = 0, vy = 0;  // motion of the box centre per frame
   };
   std::vector<Detection> find_boxes(const ImageBuffer& frame);
-  std::vector<MovenetPerson> pose(const ImageBuffer& frame, const std::vector<Box2D>& boxes);
+  // Keypoints of a crop for each box, appended to found_ (regions_ gets their squares), the
+  // crops shared by the first `copies` copies of the keypoint network.
+  void add_crops(const ImageBuffer& frame, std::span<const Box2D> boxes, int copies);
+  // Keypoints of crops_[0, count) into found_[first, first + count), on `copies` copies at once.
+  void run_keypoints(int first, int count, int copies);
+  std::vector<MovenetPerson> people_found() const;
 
   TopDownOptions options_;
-  SinglePoseNetwork pose_;
+  std::vector<std::unique_ptr<SinglePoseNetwork>> poses_;  // copy 0 runs on the calling thread
   std::unique_ptr<CenternetNetwork> boxes_;
+  std::unique_ptr<OrderedWorkers<int>> helpers_;  // workers - 1 threads; none with one worker
   GraphTensor image_, crops_;  // the networks' inputs, reused from frame to frame
+  std::vector<SquareRegion> regions_;
+  std::vector<SinglePoseKeypoints> found_;
   std::vector<Followed> followed_;
-  long long frame_ = 0, detector_runs_ = 0;
+  long long frame_ = 0;
   bool lost_someone_ = false;
+  TopDownProfile profile_;
 };
 
 }  // namespace mocap::detect

@@ -3,8 +3,9 @@
 // median keypoint distance to the reference strategy (the first listed), people per frame over
 // every frame, and frames/s end to end (decoding + detection, offline, every frame in order, so
 // that strategies that follow people between detector runs work as they would on the file). Each
-// strategy runs on each network runtime asked for (--backends: cv::dnn, XNNPACK). The networks'
-// forward time alone is mocap-bench-networks'.
+// strategy runs on each network runtime asked for (--backends: cv::dnn, XNNPACK). Top-down
+// strategies also get a table of where their time went (CenterNet, crops, keypoint passes). The
+// networks' forward time alone is mocap-bench-networks'.
 // Prints a Markdown table per input; --json writes every number.
 //
 // Also the tool that made the boxes: --candidates DIR writes the reference strategy's boxes on
@@ -53,6 +54,8 @@ struct Strategy {
   std::string name;
   std::function<People(const ImageBuffer&)> detect;
   std::function<void()> reset = [] {};
+  // Top-down only: where its time went (zero elsewhere).
+  std::function<detect::TopDownProfile()> profile = [] { return detect::TopDownProfile{}; };
   std::optional<detect::TopDownOptions> topdown;  // a top-down strategy's settings
 };
 
@@ -64,7 +67,8 @@ std::vector<std::string> split(const std::string& text, char sep) {
   return out;
 }
 
-// multipose:SIZE | tiles:CxR:TILE:FRAME | topdown:lightning|thunder:EVERY, on `backend`.
+// multipose:SIZE | tiles:CxR:TILE:FRAME | topdown:lightning|thunder:EVERY[:WORKERS[:THREADS]],
+// on `backend`; a top-down spec's own THREADS replaces `threads`.
 Strategy make_strategy(const std::string& spec, detect::Backend backend, int threads) {
   const auto parts = split(spec, ':');
   if (parts.size() == 2 && parts[0] == "multipose") {
@@ -73,7 +77,8 @@ Strategy make_strategy(const std::string& spec, detect::Backend backend, int thr
     o.backend = backend;
     o.threads = threads;
     auto d = std::make_shared<detect::MovenetDetector>(detect::movenet_model_json(), o);
-    return {spec, [d](const ImageBuffer& f) { return d->detect(f); }, [] {}, std::nullopt};
+    return {spec, [d](const ImageBuffer& f) { return d->detect(f); }, [] {},
+            [] { return detect::TopDownProfile{}; }, std::nullopt};
   }
   if (parts.size() == 4 && parts[0] == "tiles") {
     detect::TileOptions o;
@@ -86,35 +91,44 @@ Strategy make_strategy(const std::string& spec, detect::Backend backend, int thr
     o.backend = backend;
     o.threads = threads;
     auto d = std::make_shared<detect::TiledDetector>(detect::movenet_model_json(), o);
-    return {spec, [d](const ImageBuffer& f) { return d->detect(f); }, [] {}, std::nullopt};
+    return {spec, [d](const ImageBuffer& f) { return d->detect(f); }, [] {},
+            [] { return detect::TopDownProfile{}; }, std::nullopt};
   }
   if (parts.size() >= 3 && parts[0] == "topdown") {
     detect::TopDownOptions o;
     if (parts[1] != "lightning" && parts[1] != "thunder")
-      throw std::invalid_argument("topdown:lightning|thunder:EVERY, got " + spec);
+      throw std::invalid_argument(
+          "topdown:lightning|thunder:EVERY[:WORKERS[:THREADS]][:tTILES][:sSCORE], got " + spec);
     o.pose_model = parts[1] == "thunder" ? detect::SinglePoseModel::thunder
                                          : detect::SinglePoseModel::lightning;
     o.detect_every = std::stoi(parts[2]);
-    // Optional tN (person detector on N tiles) and sX (its score threshold).
+    // Then WORKERS and THREADS, and anywhere tN (person detector on N tiles) and sX (its score
+    // threshold).
+    std::vector<std::string> numbers;
     for (std::size_t i = 3; i < parts.size(); ++i) {
-      if (parts[i].size() > 1 && parts[i][0] == 't') {
+      if (parts[i].size() > 1 && parts[i][0] == 't')
         o.detector_tiles = std::stoi(parts[i].substr(1));
-      } else if (parts[i].size() > 1 && parts[i][0] == 's') {
+      else if (parts[i].size() > 1 && parts[i][0] == 's')
         o.min_box_score = std::stof(parts[i].substr(1));
-      } else {
-        throw std::invalid_argument("topdown:MODEL:EVERY[:tTILES][:sSCORE], got " + spec);
-      }
+      else
+        numbers.push_back(parts[i]);
     }
+    if (numbers.size() > 2)
+      throw std::invalid_argument(
+          "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES][:sSCORE], got " + spec);
     o.backend = backend;
-    o.threads = threads;
+    o.threads = numbers.size() == 2 ? std::stoi(numbers[1]) : threads;
+    o.workers = numbers.empty() ? 1 : std::stoi(numbers[0]);
     auto d = std::make_shared<detect::TopDownDetector>(
         o, detect::cached_model_json(detect::model_name(o.pose_model)),
         detect::cached_model_json("centernet"));
-    return {spec, [d](const ImageBuffer& f) { return d->detect(f); }, [d] { d->reset(); }, o};
+    d->warm_up();
+    return {spec, [d](const ImageBuffer& f) { return d->detect(f); }, [d] { d->reset(); },
+            [d] { return d->profile(); }, o};
   }
-  throw std::invalid_argument(
-      "unknown strategy '" + spec +
-      "' (multipose:SIZE, tiles:CxR:TILE:FRAME, topdown:MODEL:EVERY[:tTILES][:sSCORE])");
+  throw std::invalid_argument("unknown strategy '" + spec +
+                              "' (multipose:SIZE, tiles:CxR:TILE:FRAME, "
+                              "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES][:sSCORE])");
 }
 
 // Every frame of a video, or the one image of a still.
@@ -152,7 +166,16 @@ struct Run {
   std::map<int, People> people;  // every frame
   double seconds = 0;
   int frames = 0;
+  detect::TopDownProfile profile;  // of the timed frames (top-down only)
 };
+
+detect::TopDownProfile minus(detect::TopDownProfile a, const detect::TopDownProfile& b) {
+  a.frames -= b.frames, a.detector_runs -= b.detector_runs, a.crops -= b.crops;
+  a.total -= b.total, a.centernet -= b.centernet, a.crop_fill -= b.crop_fill;
+  a.centernet_wait -= b.centernet_wait;
+  a.keypoints -= b.keypoints;
+  return a;
+}
 
 // Every frame in order, or only those in `only` (sorted; empty: all).
 Run run(Strategy& s, const std::string& input, const std::vector<int>& only) {
@@ -165,6 +188,7 @@ Run run(Strategy& s, const std::string& input, const std::vector<int>& only) {
     s.reset();
   }
   Frames frames(input);
+  const detect::TopDownProfile before = s.profile();
   const auto start = Clock::now();
   for (int i = 0;; ++i) {
     auto f = frames.next();
@@ -174,6 +198,7 @@ Run run(Strategy& s, const std::string& input, const std::vector<int>& only) {
     ++r.frames;
   }
   r.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  r.profile = minus(s.profile(), before);
   return r;
 }
 
@@ -390,6 +415,32 @@ void diagnose(const std::string& input, const eval::DetectionTruth& truth, const
     std::printf("| %s | %d / %d |\n", band.c_str(), n.first, n.second);
   std::fflush(stdout);
 }
+
+// Where the top-down strategies' time went, in ms per frame.
+void print_profiles(const std::vector<std::string>& names, const std::vector<Run>& runs) {
+  bool header = false;
+  for (std::size_t s = 0; s < runs.size(); ++s) {
+    const detect::TopDownProfile& p = runs[s].profile;
+    if (p.frames == 0) continue;
+    if (!header)
+      std::printf(
+          "\n| top-down strategy | crops/frame | detector runs | ms/frame: detect() | "
+          "CenterNet (per run; on the caller) | crop cutting | keypoint passes (per crop) | rest "
+          "|\n"
+          "|---|---|---|---|---|---|---|---|\n");
+    header = true;
+    const double f = static_cast<double>(p.frames);
+    const double rest = p.total - p.centernet_wait - p.crop_fill - p.keypoints;
+    std::printf(
+        "| %s | %.2f | %lld | %.1f | %.1f (%.1f; %.1f waited) | %.1f | %.1f (%.2f) | %.1f |\n",
+        names[s].c_str(), static_cast<double>(p.crops) / f, p.detector_runs, 1e3 * p.total / f,
+        1e3 * p.centernet / f,
+        p.detector_runs ? 1e3 * p.centernet / static_cast<double>(p.detector_runs) : 0.0,
+        1e3 * p.centernet_wait / f, 1e3 * p.crop_fill / f, 1e3 * p.keypoints / f,
+        p.crops ? 1e3 * p.keypoints / static_cast<double>(p.crops) : 0.0, 1e3 * rest / f);
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -407,7 +458,9 @@ int main(int argc, char** argv) {
       .option("strategies", "LIST",
               "the first (on the first runtime) is the reference for keypoint distances: "
               "multipose:SIZE, "
-              "tiles:CxR:TILE:FRAME, topdown:lightning|thunder:EVERY",
+              "tiles:CxR:TILE:FRAME, topdown:lightning|thunder:EVERY[:WORKERS[:THREADS]] "
+              "(workers: copies of the keypoint network sharing a frame's crops; a top-down "
+              "strategy also prints where its time went)",
               "topdown:thunder:1,multipose:256,multipose:512,tiles:2x2:256:256,"
               "topdown:lightning:1,topdown:lightning:10,topdown:thunder:10")
       .option("truth", "DIR", "hand-checked boxes", "tests/data/detection")
@@ -518,6 +571,7 @@ int main(int argc, char** argv) {
                         {"frames", runs[s].frames},
                         {"seconds", runs[s].seconds}});
       }
+      print_profiles(names, runs);
       std::fflush(stdout);
       if (args.has("diagnose") && truth)
         for (std::size_t s = 0; s < runs.size(); ++s)

@@ -1,7 +1,7 @@
 // mocap-bench-video: the whole method on real videos, end to end (decode -> detector -> tracker ->
 // scaler -> matcher -> temporal selection -> smoothing -> JSONL, BVH and overlay MP4), per video
 // and detection strategy (mocap reconstruct --detector names; multipose ones per input size) x
-// network runtime x workers (detect.movenet only) x threads, in
+// network runtime x workers (detect.movenet, detect.topdown) x threads, in
 // two runs each:
 //  * offline: every frame, as fast as possible (the graph of `mocap reconstruct VIDEO`):
 //    frames per second, people per frame, tracks longer than 50 frames, id breaks and jumps;
@@ -181,10 +181,12 @@ std::string detector_node(const RunSpec& s) {
   std::ostringstream node;
   node << "{ type: " << preset.type << ", params: { threads: " << s.detector_threads
        << ", backend: " << s.backend;
-  // Copies on consecutive frames: detect.movenet only (the others follow people frame to frame).
-  if (preset.type == "detect.movenet") node << ", workers: " << s.workers;
+  // Copies of the network: on consecutive frames (detect.movenet) or sharing a frame's crops
+  // (detect.topdown); the tiles have none.
+  if (preset.type != "detect.tiles") node << ", workers: " << s.workers;
   for (const auto& [key, value] : preset.params)
-    node << ", " << key << ": " << (key == "input_size" ? std::to_string(s.size) : value);
+    if (key != "workers")
+      node << ", " << key << ": " << (key == "input_size" ? std::to_string(s.size) : value);
   node << " } }";
   return node.str();
 }
@@ -328,7 +330,9 @@ int main(int argc, char** argv) {
       .option("threads", "LIST", "detector threads per worker (0: the runtime's default)", "0")
       .option("backends", "LIST", "detector runtimes: auto, xnnpack, opencv", "auto")
       .option("workers", "LIST",
-              "detector workers (copies on consecutive frames; detect.movenet only)", "1")
+              "detector workers (network copies: on consecutive frames for multipose, sharing a "
+              "frame's crops for topdown; not tiles)",
+              "1")
       .option("lag", "N", "temporal selection look-ahead in frames", "8")
       .option("out", "DIR", "where each run's outputs go", "/tmp/mocap-bench-video");
   int exit_code = 0;

@@ -8,9 +8,9 @@
 #include <iostream>
 #include <optional>
 
-#include "detect/model_files.hpp"
 #include "detect/movenet_workers.hpp"
 #include "graph/registry.hpp"
+#include "network_params.hpp"
 #include "people_message.hpp"
 
 namespace mocap::nodes {
@@ -27,17 +27,11 @@ class MovenetNode : public Node {
                  {128, 1024});
     c.param<double>("min_person_score", 0.25, "people scoring below are dropped", {0.0, 1.0});
     c.param<double>("min_keypoint_score", 0.3, "keypoints scoring below are missing", {0.0, 1.0});
-    c.param<std::string>("backend", "auto",
-                         "network runtime: auto (XNNPACK when built in, else cv::dnn), xnnpack, "
-                         "opencv");
+    declare_network_params(c, "XNNPACK 1, cv::dnn OpenCV's default with 1 worker, else 1");
     c.param<int>("workers", 1,
                  "copies of the network on consecutive frames, each on its own thread (2: both "
                  "cores); outputs stay in frame order",
                  {1, 16});
-    c.param<int>("threads", 0,
-                 "threads per copy (0: XNNPACK 1, cv::dnn OpenCV's default with 1 worker, else "
-                 "1); cv::dnn's setting is process-wide",
-                 {0, 64});
     c.param<bool>("warm_up", true, "run the network on blank 4:3 and 16:9 frames when it opens");
     c.param<std::string>("model", "", "model.json (empty: the cache tools/setup.sh fills)");
   }
@@ -47,9 +41,10 @@ class MovenetNode : public Node {
     options.input_size = ctx.param<int>("input_size");
     options.thresholds.min_person_score = ctx.param<float>("min_person_score");
     options.thresholds.min_keypoint_score = ctx.param<float>("min_keypoint_score");
-    options.backend = detect::parse_backend(ctx.param<std::string>("backend"));
-    options.threads = ctx.param<int>("threads");
-    workers_.emplace(model_path(ctx.param<std::string>("model")), options,
+    const NetworkParams network = read_network_params(ctx);
+    options.backend = network.backend;
+    options.threads = network.threads;
+    workers_.emplace(model_file(ctx, "model", "movenet-multipose"), options,
                      ctx.param<int>("workers"));
     std::cerr << "node '" << ctx.node_name() << "': MoveNet on "
               << detect::backend_name(workers_->backend()) << ", " << workers_->workers()
@@ -80,15 +75,6 @@ class MovenetNode : public Node {
     out.header = headers_.front();
     headers_.pop_front();
     ctx.send("out", std::move(out));
-  }
-
-  static std::filesystem::path model_path(const std::string& given) {
-    if (given.empty()) return detect::movenet_model_json();
-    if (!std::filesystem::is_regular_file(given))
-      throw detect::ModelMissing("model file " + given +
-                                 " not found; run tools/setup.sh --models-only to fetch the "
-                                 "MoveNet model into the cache, or leave `model` empty");
-    return given;
   }
 
   std::optional<detect::MovenetWorkers> workers_;

@@ -5,9 +5,9 @@
 #include <iostream>
 #include <optional>
 
-#include "detect/model_files.hpp"
 #include "detect/tiled_detector.hpp"
 #include "graph/registry.hpp"
+#include "network_params.hpp"
 #include "people_message.hpp"
 
 namespace mocap::nodes {
@@ -32,13 +32,7 @@ class TilesNode : public Node {
                  {0, 1024});
     c.param<double>("min_person_score", 0.25, "people scoring below are dropped", {0.0, 1.0});
     c.param<double>("min_keypoint_score", 0.3, "keypoints scoring below are missing", {0.0, 1.0});
-    c.param<std::string>("backend", "auto",
-                         "network runtime: auto (XNNPACK when built in, else cv::dnn), xnnpack, "
-                         "opencv");
-    c.param<int>("threads", 0,
-                 "network threads (0: XNNPACK 1, cv::dnn OpenCV's default); cv::dnn's setting is "
-                 "process-wide",
-                 {0, 64});
+    declare_network_params(c, "XNNPACK 1, cv::dnn OpenCV's default");
     c.param<std::string>("model", "", "model.json (empty: the cache tools/setup.sh fills)");
   }
 
@@ -51,14 +45,10 @@ class TilesNode : public Node {
     o.frame_input_size = ctx.param<int>("frame_input_size");
     o.thresholds.min_person_score = ctx.param<float>("min_person_score");
     o.thresholds.min_keypoint_score = ctx.param<float>("min_keypoint_score");
-    o.backend = detect::parse_backend(ctx.param<std::string>("backend"));
-    o.threads = ctx.param<int>("threads");
-    const std::string given = ctx.param<std::string>("model");
-    if (!given.empty() && !std::filesystem::is_regular_file(given))
-      throw detect::ModelMissing("model file " + given + " not found; " + detect::kFetchModelsHint +
-                                 ", or leave `model` empty");
-    detector_.emplace(given.empty() ? detect::movenet_model_json() : std::filesystem::path(given),
-                      o);
+    const NetworkParams network = read_network_params(ctx);
+    o.backend = network.backend;
+    o.threads = network.threads;
+    detector_.emplace(model_file(ctx, "model", "movenet-multipose"), o);
     std::cerr << "node '" << ctx.node_name() << "': tiles on "
               << detect::backend_name(detector_->backend()) << "\n";
   }

@@ -6,9 +6,9 @@
 #include <iostream>
 #include <optional>
 
-#include "detect/model_files.hpp"
 #include "detect/topdown_detector.hpp"
 #include "graph/registry.hpp"
+#include "network_params.hpp"
 #include "people_message.hpp"
 
 namespace mocap::nodes {
@@ -41,13 +41,15 @@ class TopDownNode : public Node {
     c.param<double>("min_keypoint_score", 0.3, "keypoints scoring below are missing", {0.0, 1.0});
     c.param<double>("crop_padding", 1.25, "crop side = the person's longer box side x this",
                     {1.0, 4.0});
-    c.param<std::string>("backend", "auto",
-                         "network runtime: auto (XNNPACK when built in, else cv::dnn), xnnpack, "
-                         "opencv");
-    c.param<int>("threads", 0,
-                 "network threads (0: XNNPACK 1, cv::dnn OpenCV's default); cv::dnn's setting is "
-                 "process-wide",
-                 {0, 64});
+    declare_network_params(c, "1 per worker on XNNPACK, cv::dnn's default with 1 worker");
+    c.param<int>("workers", 1,
+                 "copies of the keypoint network sharing each frame's crops, each on its own "
+                 "thread (2: both cores); the person detector then runs beside the followed "
+                 "people's crops",
+                 {1, 16});
+    c.param<bool>("warm_up", true,
+                  "build the networks for every batch shape when the node opens, so that a live "
+                  "source's first frames are not late");
     c.param<std::string>("pose_model_file", "", "model.json (empty: the cache)");
     c.param<std::string>("box_model_file", "", "CenterNet model.json (empty: the cache)");
   }
@@ -66,14 +68,15 @@ class TopDownNode : public Node {
     o.min_keypoints = ctx.param<int>("min_keypoints");
     o.min_keypoint_score = ctx.param<float>("min_keypoint_score");
     o.crop_padding = ctx.param<float>("crop_padding");
-    o.backend = detect::parse_backend(ctx.param<std::string>("backend"));
-    o.threads = ctx.param<int>("threads");
-    detector_.emplace(
-        o,
-        file_or_cache(ctx.param<std::string>("pose_model_file"), detect::model_name(o.pose_model)),
-        file_or_cache(ctx.param<std::string>("box_model_file"), "centernet"));
+    const NetworkParams network = read_network_params(ctx);
+    o.backend = network.backend;
+    o.threads = network.threads;
+    o.workers = ctx.param<int>("workers");
+    detector_.emplace(o, model_file(ctx, "pose_model_file", detect::model_name(o.pose_model)),
+                      model_file(ctx, "box_model_file", "centernet"));
     std::cerr << "node '" << ctx.node_name() << "': top-down on "
-              << detect::backend_name(detector_->backend()) << "\n";
+              << detect::backend_name(detector_->backend()) << ", " << o.workers << " worker(s)\n";
+    if (ctx.param<bool>("warm_up")) detector_->warm_up();
   }
 
   void process(Context& ctx) override {
@@ -81,14 +84,6 @@ class TopDownNode : public Node {
   }
 
  private:
-  static std::filesystem::path file_or_cache(const std::string& given, std::string_view name) {
-    if (given.empty()) return detect::cached_model_json(name);
-    if (!std::filesystem::is_regular_file(given))
-      throw detect::ModelMissing("model file " + given + " not found; " + detect::kFetchModelsHint +
-                                 ", or leave the parameter empty");
-    return given;
-  }
-
   std::optional<detect::TopDownDetector> detector_;
 };
 

@@ -1,0 +1,140 @@
+// detect::TopDownDetector on both cores: the crops of a frame shared by two single-thread copies
+// of the keypoint network, CenterNet beside the followed people's crops, must find what one copy
+// finds (same people, same keypoints); SinglePoseNetwork's run over part of a batch equals that
+// part of the whole run; the profile counts what ran. Real models, a real vtest frame moving a
+// few pixels per frame so that people are followed between detector runs.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "detect/model_files.hpp"
+#include "detect/topdown_detector.hpp"
+
+namespace mocap::detect {
+namespace {
+
+namespace fs = std::filesystem;
+
+const fs::path kFrame =
+    fs::path("..") / "shared" / "docs" / "models" / "movenet-multipose" / "vtest-f300.png";
+
+struct Models {
+  fs::path lightning, centernet;
+};
+
+// The models and frame, or the reason to skip.
+std::optional<Models> models(std::string& why) {
+  try {
+    Models m{cached_model_json(model_name(SinglePoseModel::lightning)),
+             cached_model_json("centernet")};
+    if (!fs::exists(kFrame)) {
+      why = "reference frame absent: " + kFrame.string();
+      return std::nullopt;
+    }
+    return m;
+  } catch (const ModelMissing& e) {
+    why = e.what();
+    return std::nullopt;
+  }
+}
+
+// The frame moved right by `shift` pixels, as a bgr8 ImageBuffer owning its pixels.
+ImageBuffer shifted_frame(int shift) {
+  const cv::Mat frame = cv::imread(kFrame.string());
+  cv::Mat moved;
+  const cv::Mat m = (cv::Mat_<double>(2, 3) << 1, 0, shift, 0, 1, 0);
+  cv::warpAffine(frame, moved, m, frame.size());
+  auto owner = std::make_shared<cv::Mat>(moved);
+  return ImageBuffer(moved.cols, moved.rows, static_cast<int>(moved.step[0]), PixelFormat::bgr8,
+                     owner, reinterpret_cast<const std::byte*>(owner->data));
+}
+
+std::vector<std::vector<MovenetPerson>> run_frames(int workers, TopDownProfile& profile) {
+  std::string why;
+  const auto m = models(why);
+  TopDownOptions o;
+  o.detect_every = 3;
+  o.backend = Backend::automatic;
+  o.workers = workers;
+  TopDownDetector detector(o, m->lightning, m->centernet);
+  if (workers > 1) detector.warm_up();  // one copy builds its shapes on the frames
+  std::vector<std::vector<MovenetPerson>> out;
+  for (int i = 0; i < 5; ++i) out.push_back(detector.detect(shifted_frame(2 * i)));
+  profile = detector.profile();
+  return out;
+}
+
+TEST(TopDownDetector, TwoWorkersFindWhatOneFinds) {
+  std::string why;
+  if (!models(why)) GTEST_SKIP() << why;
+  TopDownProfile one_profile, two_profile;
+  const auto one = run_frames(1, one_profile);
+  const auto two = run_frames(2, two_profile);
+  ASSERT_EQ(one.size(), two.size());
+  for (std::size_t f = 0; f < one.size(); ++f) {
+    SCOPED_TRACE(f);
+    EXPECT_GE(one[f].size(), 4u);  // the pedestrians of frame 300
+    ASSERT_EQ(one[f].size(), two[f].size());
+    for (std::size_t p = 0; p < one[f].size(); ++p) {
+      EXPECT_GT(iou(one[f][p].box, two[f][p].box), 0.98f) << p;
+      for (int k = 0; k < kMovenetKeypoints; ++k) {
+        const Keypoint2D &a = one[f][p].keypoints[k], &b = two[f][p].keypoints[k];
+        EXPECT_EQ(std::isfinite(a.x), std::isfinite(b.x)) << p << " " << k;
+        if (std::isfinite(a.x) && std::isfinite(b.x)) {
+          EXPECT_LT(std::hypot(a.x - b.x, a.y - b.y), 0.5) << p << " " << k;
+        }
+      }
+    }
+  }
+  for (const TopDownProfile* p : {&one_profile, &two_profile}) {
+    EXPECT_EQ(p->frames, 5);
+    EXPECT_EQ(p->detector_runs, 2);  // frames 0 and 3: nobody is lost
+    EXPECT_GE(p->crops, 20);
+    EXPECT_GT(p->keypoints, 0.0);
+    EXPECT_GT(p->centernet, 0.0);
+    EXPECT_GE(p->total, p->keypoints + p->crop_fill);
+  }
+}
+
+TEST(TopDownDetector, PartOfABatchEqualsThatPartOfTheWholeRun) {
+  std::string why;
+  const auto m = models(why);
+  if (!m) GTEST_SKIP() << why;
+  SinglePoseNetwork network(SinglePoseModel::lightning, m->lightning);
+  GraphTensor batch;
+  batch.shape = {5, 192, 192, 3};
+  batch.values.resize(batch.size());
+  for (std::size_t i = 0; i < batch.values.size(); ++i)
+    batch.values[i] = static_cast<float>((i * 7919) % 256);
+  const std::vector<SinglePoseKeypoints> whole = network.run(batch);
+  std::vector<SinglePoseKeypoints> part(3);
+  network.run(batch, 2, 3, part);
+  for (int n = 0; n < 3; ++n)
+    for (int k = 0; k < kMovenetKeypoints; ++k)
+      for (int i = 0; i < 3; ++i)
+        EXPECT_NEAR(part[static_cast<std::size_t>(n)][k][i],
+                    whole[static_cast<std::size_t>(n + 2)][k][i], 1e-5);
+  EXPECT_THROW(network.run(batch, 4, 2, part), std::invalid_argument);
+}
+
+TEST(TopDownDetector, WorkersOutsideTheRangeAreRefused) {
+  std::string why;
+  const auto m = models(why);
+  if (!m) GTEST_SKIP() << why;
+  TopDownOptions o;
+  o.workers = 0;
+  EXPECT_THROW(TopDownDetector(o, m->lightning, m->centernet), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace mocap::detect
