@@ -7,6 +7,7 @@
 
 #include "camera/board_detection.hpp"
 #include "core/input_error.hpp"
+#include "core/messages.hpp"
 
 namespace mocap::camera {
 namespace {
@@ -53,10 +54,14 @@ class Collector {
     cv::Mat K, D;
     result_.rms_px = cv::aruco::calibrateCameraCharuco(
         corners_, ids_, detail::charuco_board(options_.board), size_, K, D);
-    CameraIntrinsics& c = result_.camera;
+    Camera& c = result_.camera;
+    c.name = std::string(kDefaultCamera);
     c.width = size_.width;
     c.height = size_.height;
-    for (int i = 0; i < 9; ++i) c.K[i] = K.at<double>(i / 3, i % 3);
+    c.fx = K.at<double>(0, 0);
+    c.fy = K.at<double>(1, 1);
+    c.cx = K.at<double>(0, 2);
+    c.cy = K.at<double>(1, 2);
     c.distortion.assign(D.begin<double>(), D.end<double>());
     return std::move(result_);
   }

@@ -7,6 +7,7 @@
 
 #include "camera/board_detection.hpp"
 #include "core/input_error.hpp"
+#include "core/messages.hpp"
 
 namespace mocap::camera {
 namespace {
@@ -69,10 +70,14 @@ class Collector {
     cv::Mat K, D;
     std::vector<cv::Mat> rvecs, tvecs;
     result_.rms_px = cv::calibrateCamera(object_points, image_points_, size_, K, D, rvecs, tvecs);
-    CameraIntrinsics& c = result_.camera;
+    Camera& c = result_.camera;
+    c.name = std::string(kDefaultCamera);
     c.width = size_.width;
     c.height = size_.height;
-    for (int i = 0; i < 9; ++i) c.K[i] = K.at<double>(i / 3, i % 3);
+    c.fx = K.at<double>(0, 0);
+    c.fy = K.at<double>(1, 1);
+    c.cx = K.at<double>(0, 2);
+    c.cy = K.at<double>(1, 2);
     c.distortion.assign(D.begin<double>(), D.end<double>());
     return std::move(result_);
   }

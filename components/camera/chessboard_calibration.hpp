@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "camera/camera_file.hpp"
+#include "camera/camera.hpp"
 
 namespace mocap::camera {
 
@@ -24,7 +24,7 @@ struct SkippedView {
 
 // What a calibration from board views found (chessboard here, ChArUco in charuco_calibration.hpp).
 struct BoardCalibration {
-  CameraIntrinsics camera;
+  Camera camera;                  // intrinsics, named cam_01, at the world origin
   double rms_px = 0.0;            // RMS reprojection error over all corners
   std::vector<std::string> used;  // views whose board was found
   std::vector<SkippedView> skipped;

@@ -1,5 +1,6 @@
 #include "camera/ground_from_board.hpp"
 
+#include <array>
 #include <cmath>
 #include <stdexcept>
 
@@ -11,11 +12,13 @@
 
 namespace mocap::camera {
 
-FloorFromBoard ground_from_board_image(const std::string& image, const CameraIntrinsics& camera,
+FloorFromBoard ground_from_board_image(const std::string& image, const Camera& camera,
                                        const BoardSpec& board, double board_thickness_mm) {
   check_board(board);
   if (!(board_thickness_mm >= 0 && std::isfinite(board_thickness_mm)))
     throw std::invalid_argument("ground from board: thickness must be finite and >= 0");
+  if (camera.fisheye)
+    throw std::invalid_argument("ground from board: a fisheye camera is not supported");
   cv::Mat picture;
   try {
     picture = cv::imread(image, cv::IMREAD_COLOR);
@@ -28,7 +31,8 @@ FloorFromBoard ground_from_board_image(const std::string& image, const CameraInt
                                 std::to_string(picture.rows) + ", the camera file is for " +
                                 std::to_string(camera.width) + "x" + std::to_string(camera.height));
   cv::Mat K(3, 3, CV_64F);
-  for (int i = 0; i < 9; ++i) K.at<double>(i / 3, i % 3) = camera.K[i];
+  const std::array<double, 9> k = camera.matrix();
+  for (int i = 0; i < 9; ++i) K.at<double>(i / 3, i % 3) = k[static_cast<std::size_t>(i)];
   cv::Mat D = cv::Mat::zeros(1, 5, CV_64F);
   if (!camera.distortion.empty()) D = cv::Mat(camera.distortion, true).reshape(1, 1);
 

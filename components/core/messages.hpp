@@ -7,12 +7,14 @@
 #include <cstdint>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include <glm/gtc/quaternion.hpp>
 #include <glm/vec3.hpp>
 
 #include "core/body15.hpp"
+#include "core/ground_plane.hpp"
 #include "core/image_buffer.hpp"
 #include "core/keypoint_layout.hpp"
 
@@ -33,9 +35,15 @@ struct Message {
   Header header;
 };
 
+// Cameras are named as in the rig file (camera::Rig, docs/cameras.md): a message says which
+// camera saw it by that name, so it stays unambiguous across processes and hosts. A graph with one
+// camera uses kDefaultCamera unless its source names another (its `camera` parameter); a
+// single-camera file reads as a rig whose one camera has this name.
+inline constexpr std::string_view kDefaultCamera = "cam_01";
+
 struct VideoFrame : Message {
   static constexpr std::string_view kTypeName = "VideoFrame";
-  int camera_id = 0;
+  std::string camera{kDefaultCamera};  // the camera's name in the rig
   ImageBuffer image;
 };
 
@@ -57,7 +65,22 @@ struct Person2D {
 struct People2D : Message {
   static constexpr std::string_view kTypeName = "People2D";
   LayoutId layout = LayoutId::coco17;
+  std::string camera{kDefaultCamera};  // whose image the keypoints are in (its name in the rig)
   std::vector<Person2D> people;
+};
+
+// The coordinate frame 3D values are in: a camera's (x right, y down, z forward, metres, the
+// camera centre at the origin), named as in the rig, or the rig's world (metres; its axes are the
+// rig file's, e.g. Z up for Pose2Sim's and HumanEva's).
+struct CoordinateFrame {
+  enum class Kind : std::uint8_t { camera = 0, world = 1 };
+  Kind kind = Kind::camera;
+  std::string camera{kDefaultCamera};  // kind camera: which camera; world: empty
+
+  static CoordinateFrame of_camera(std::string name) { return {Kind::camera, std::move(name)}; }
+  static CoordinateFrame world() { return {Kind::world, {}}; }
+  bool is_world() const { return kind == Kind::world; }
+  bool operator==(const CoordinateFrame&) const = default;
 };
 
 struct RigidTransform {
@@ -78,14 +101,17 @@ inline std::array<glm::quat, kBodyJoints> identity_rotations() {
   return rotations;
 }
 
+// One person in the coordinate frame of their People3D message (People3D::frame).
 struct Person3D {
   int id = -1;
-  // Metres, camera coordinates (x right, y down, z forward), indexed by mocap::Joint; relative to
-  // the root (mid-hips), which sits at the origin.
+  // Metres, indexed by mocap::Joint, along the axes of the message's frame; relative to the root
+  // (mid-hips), which sits at the origin. The joints in the frame: joints_in_frame().
   std::array<glm::vec3, kBodyJoints> positions{};
   std::array<glm::quat, kBodyJoints> rotations = identity_rotations();  // local joint rotations
-  // rotation: the matched database body turned into the camera frame. translation: where the root
-  // is in the camera frame (metres) once it is estimated (`placed`, the fitting), else zero.
+  // rotation: the matched database body turned into the message's frame. translation: where the
+  // root is in that frame (metres) once it is estimated (`placed`: the fitting, or a multi-view
+  // triangulation), else zero. A person in the world frame is always placed: their joints in the
+  // world are positions + root.translation (poses.jsonl's `joints_world`).
   RigidTransform root;
   bool placed = false;
   Provenance provenance;
@@ -94,18 +120,22 @@ struct Person3D {
   std::array<Keypoint2D, kBodyJoints> keypoints{};
 };
 
-// The floor in the camera frame: points x with dot(normal, x) + offset = 0, `normal` a unit vector
-// pointing up (away from the floor), so the camera centre is `offset` metres above the floor.
-struct GroundPlane {
-  glm::vec3 normal{0.0f, -1.0f, 0.0f};
-  float offset = 0.0f;
-};
+// The joints where they are in the message's frame: positions + root.translation (meaningful
+// when the person is `placed`).
+inline std::array<glm::vec3, kBodyJoints> joints_in_frame(const Person3D& person) {
+  std::array<glm::vec3, kBodyJoints> out = person.positions;
+  for (glm::vec3& p : out) p += person.root.translation;
+  return out;
+}
 
 struct People3D : Message {
   static constexpr std::string_view kTypeName = "People3D";
+  // The frame of every person's positions and root, and of `ground`. The monocular pipeline
+  // works in its camera's frame; a multi-view reconstruction in the rig's world.
+  CoordinateFrame frame;
   std::vector<Person3D> people;
   bool has_ground = false;  // the floor is known (calibrated or estimated from the feet)
-  GroundPlane ground;
+  GroundPlane ground;       // in `frame`
 };
 
 // A person prepared for the pose database (the scaler fills `normalized`) and matched against
@@ -130,6 +160,7 @@ struct PersonMatch {
 
 struct PoseMatches : Message {
   static constexpr std::string_view kTypeName = "PoseMatches";
+  std::string camera{kDefaultCamera};  // the People2D's camera: the poses are made in its frame
   std::vector<PersonMatch> people;
 };
 

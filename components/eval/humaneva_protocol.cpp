@@ -81,8 +81,8 @@ std::vector<recon::BodyXyc> input_2d(const std::vector<he::Pose2>& positions, do
 }
 
 // The 3D truth, resampled, as Body15 in the camera's frame.
-std::vector<Body> truth_in_camera(const std::vector<he::Pose3>& positions, const he::Camera& camera,
-                                  double fps) {
+std::vector<Body> truth_in_camera(const std::vector<he::Pose3>& positions,
+                                  const camera::Camera& camera, double fps) {
   std::vector<Body> out;
   for (const he::Pose3& frame :
        motion::resample_points(std::span<const he::Pose3>(positions), he::kFps, fps)) {
@@ -109,15 +109,10 @@ std::vector<HumanEvaSequence> humaneva_validation_sequences(const he::Dataset& d
           if (chunk->positions_2d[c].size() != chunk->frames())
             throw InputError(std::string(he::kPositions2dFile),
                              "no 2D for " + chunk->subject + " " + chunk->key);
-          const he::Camera& camera = subject_cameras->second[c];
-          out.push_back({chunk->subject,
-                         std::string(action.label),
-                         chunk->key,
-                         camera.id,
+          const camera::Camera& camera = subject_cameras->second.cameras.at(c);
+          out.push_back({chunk->subject, std::string(action.label), chunk->key, camera,
                          input_2d(chunk->positions_2d[c], fps),
-                         truth_in_camera(chunk->positions_3d, camera, fps),
-                         {static_cast<float>(camera.fx), static_cast<float>(camera.fy),
-                          static_cast<float>(camera.cx), static_cast<float>(camera.cy)}});
+                         truth_in_camera(chunk->positions_3d, camera, fps)});
         }
       }
     }

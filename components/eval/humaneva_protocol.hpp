@@ -52,18 +52,17 @@ std::vector<posedb::BodySequence> humaneva_body_sequences(
     const io::humaneva::Dataset& dataset, io::humaneva::Split split,
     const std::vector<std::string_view>& actions);
 
-using HumanEvaCameras =
-    std::map<std::string, std::array<io::humaneva::Camera, io::humaneva::kCameras>>;
+// Subject -> the rig of its cameras C1..C3 (io::humaneva::load_cameras).
+using HumanEvaCameras = std::map<std::string, camera::Rig>;
 
 // One Validate chunk seen by one camera, at the evaluation rate.
 struct HumanEvaSequence {
   std::string subject;                // "S1"
   std::string action;                 // label: "Walk", "Jog", "Box"
   std::string chunk;                  // as in the data: "Walking 1 chunk0"
-  std::string camera;                 // "C1"
+  camera::Camera camera;              // "C1": the (approximate, fitted) pinhole and its pose
   std::vector<recon::BodyXyc> input;  // ground-truth 2D, pixels, confidence 1, no noise
   std::vector<Body> truth_camera;     // camera frame (x right, y down, z forward), metres
-  recon::Pinhole intrinsics;          // the camera's (approximate, fitted) pinhole
 };
 
 // Every Validate chunk of the evaluated subjects and actions through every camera, resampled

@@ -286,19 +286,19 @@ namespace {
 
 // Pixel (x, y) and depth (metres along the optical axis) of a TRC point (Y up) in a camera of the
 // Z-up calibration world.
-glm::dvec3 project_trc(const camera::Pose2SimCamera& cam, const glm::vec3& trc) {
+glm::dvec3 project_trc(const camera::Camera& cam, const glm::vec3& trc) {
   const glm::dvec3 world(trc.z, trc.x, trc.y);
-  const glm::dvec2 pixel = cam.project(world);
+  const glm::dvec2 pixel = cam.project_pinhole(world);
   return {pixel.x, pixel.y, cam.to_camera(world).z};
 }
 
 }  // namespace
 
-std::array<JointFit, kBodyJoints> evaluate_offsets_2d(
-    const recon::LayoutOffsets& offsets, std::span<const CalibrationFrame> frames,
-    std::span<const camera::Pose2SimCamera> cameras) {
+std::array<JointFit, kBodyJoints> evaluate_offsets_2d(const recon::LayoutOffsets& offsets,
+                                                      std::span<const CalibrationFrame> frames,
+                                                      std::span<const camera::Camera> cameras) {
   std::array<JointFit, kBodyJoints> out{};
-  for (const camera::Pose2SimCamera& cam : cameras) {
+  for (const camera::Camera& cam : cameras) {
     for (const CalibrationFrame& c : frames) {
       std::array<float, kBodyJoints * 3> body;
       std::array<glm::dvec3, kBodyJoints> reference;
@@ -315,7 +315,7 @@ std::array<JointFit, kBodyJoints> evaluate_offsets_2d(
       for (int j = 0; j < kBodyJoints; ++j) {
         if (body[3 * j + 2] <= 0.0f || !std::isfinite(reference[j].z) || reference[j].z <= 0)
           continue;
-        const double mm_per_px = 1000.0 * reference[j].z / cam.intrinsics.fx();
+        const double mm_per_px = 1000.0 * reference[j].z / cam.fx;
         const glm::dvec2 ref(reference[j].x, reference[j].y);
         JointFit& f = out[j];
         f.before_mm += mm_per_px * glm::length(glm::dvec2(body[3 * j], body[3 * j + 1]) - ref);

@@ -23,7 +23,7 @@
 
 #include <glm/vec3.hpp>
 
-#include "camera/pose2sim_calibration.hpp"
+#include "camera/camera.hpp"
 #include "core/body15.hpp"
 #include "core/keypoint_layout.hpp"
 #include "io/humaneva.hpp"
@@ -88,11 +88,11 @@ std::array<JointFit, kBodyJoints> evaluate_offsets_3d(const recon::LayoutOffsets
 
 // The 2D check: keypoints and reference (TRC points, Y up; the calibration's world is Z up:
 // X_w = Z_trc, Y_w = X_trc, Z_w = Y_trc) projected through each camera of a Pose2Sim calibration
-// (camera/pose2sim_calibration.hpp), the 2D correction
+// (camera/rig_file.hpp; pinhole projection), the 2D correction
 // applied to the projected keypoints; mean distance before/after per joint, in millimetres at
 // the joint's depth (pixels * depth / f).
-std::array<JointFit, kBodyJoints> evaluate_offsets_2d(
-    const recon::LayoutOffsets& offsets, std::span<const CalibrationFrame> frames,
-    std::span<const camera::Pose2SimCamera> cameras);
+std::array<JointFit, kBodyJoints> evaluate_offsets_2d(const recon::LayoutOffsets& offsets,
+                                                      std::span<const CalibrationFrame> frames,
+                                                      std::span<const camera::Camera> cameras);
 
 }  // namespace mocap::eval

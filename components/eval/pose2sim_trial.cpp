@@ -6,6 +6,7 @@
 
 #include <glm/geometric.hpp>
 
+#include "camera/rig_file.hpp"
 #include "core/input_error.hpp"
 #include "core/keypoint_layout.hpp"
 #include "io/openpose_json.hpp"
@@ -83,7 +84,7 @@ Pose2SimTrial load_pose2sim_trial(const fs::path& trial, const fs::path& calibra
                                   std::size_t max_frames) {
   Pose2SimTrial out;
   out.folder = trial.string();
-  const auto cameras = camera::read_pose2sim_calibration(calibration);
+  const auto cameras = camera::read_rig(calibration).cameras;
   const auto folders = json_folders(trial / "pose");
   if (folders.size() != cameras.size())
     throw InputError((trial / "pose").string(),
@@ -130,7 +131,7 @@ Pose2SimTrial load_pose2sim_trial(const fs::path& trial, const fs::path& calibra
       Body cam;
       for (int j = 0; j < kBodyJoints; ++j) {
         const glm::dvec3 w(out.truth_world[t][j]);
-        ref[j] = view.camera.project(w);
+        ref[j] = view.camera.project_pinhole(w);
         cam[j] = glm::vec3(view.camera.to_camera(w));
       }
       view.truth_camera.push_back(cam);
@@ -154,7 +155,7 @@ Pose2SimTrial load_pose2sim_trial(const fs::path& trial, const fs::path& calibra
           const glm::vec3& p = trc.frames[t][m];
           if (!(kp.confidence > 0) || !std::isfinite(p.x)) continue;
           marker_d.push_back(
-              glm::distance(view.camera.project(trc_to_world(p)), glm::dvec2(kp.x, kp.y)));
+              glm::distance(view.camera.project_pinhole(trc_to_world(p)), glm::dvec2(kp.x, kp.y)));
         }
       view.marker_reprojection_px.push_back(median(marker_d));
     }

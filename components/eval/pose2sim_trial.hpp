@@ -1,6 +1,6 @@
 #pragma once
 // A Pose2Sim trial (../shared/data/eval/pose2sim_demo/, see its README) as input for monocular
-// evaluation with its true cameras: the calibration (camera/pose2sim_calibration.hpp), each
+// evaluation with its true cameras: the calibration (a rig file, camera/rig_file.hpp), each
 // camera's OpenPose BODY_25B JSON as Body15 keypoints, and Pose2Sim's own triangulated 3D (the
 // *_filt_butterworth.trc file: its BODY_25B markers as Body15, root = mid-hip) as the reference,
 // in the calibration's Z-up world frame. (The *_LSTM.trc file's copies of those markers are
@@ -17,14 +17,14 @@
 #include <string>
 #include <vector>
 
-#include "camera/pose2sim_calibration.hpp"
+#include "camera/camera.hpp"
 #include "eval/virtual_protocol.hpp"
 #include "recon/sequence_reconstruction.hpp"
 
 namespace mocap::eval {
 
 struct Pose2SimView {
-  camera::Pose2SimCamera camera;
+  camera::Camera camera;
   std::string json_folder;
   std::vector<recon::BodyXyc> input;    // the participant per frame (confidence 0: none)
   std::vector<double> reprojection_px;  // per frame: median distance to the reference; NaN

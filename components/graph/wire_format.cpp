@@ -55,6 +55,8 @@ class Reader {
     need(size);
     pos_ += size;
   }
+  // A u16 length and that many bytes of a camera name (check_camera_name).
+  std::string get_camera_name(const char* what);
   void expect_end() const {
     if (pos_ != frame_.size) {
       throw WireError(std::string(what_) + " frame has " + std::to_string(frame_.size - pos_) +
@@ -78,6 +80,33 @@ void expect_size(const Frame& frame, std::size_t expected, const char* what) {
   }
 }
 
+// A camera name: 1..kMaxCameraNameBytes bytes without control characters.
+void check_camera_name(std::string_view name, const char* what) {
+  if (name.empty()) throw WireError(std::string(what) + ": empty camera name");
+  if (name.size() > kMaxCameraNameBytes)
+    throw WireError(std::string(what) + ": camera name longer than " +
+                    std::to_string(kMaxCameraNameBytes) + " bytes");
+  for (const char c : name)
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f)
+      throw WireError(std::string(what) + ": a control character in the camera name");
+}
+
+std::string Reader::get_camera_name(const char* what) {
+  const auto size = get<std::uint16_t>();
+  if (size > kMaxCameraNameBytes)
+    throw WireError(std::string(what) + ": camera name longer than " +
+                    std::to_string(kMaxCameraNameBytes) + " bytes");
+  std::string name = get_string(size);
+  check_camera_name(name, what);
+  return name;
+}
+
+void put_camera_name(Writer& w, const std::string& name, const char* what) {
+  check_camera_name(name, what);
+  w.put<std::uint16_t>(static_cast<std::uint16_t>(name.size()));
+  w.put_bytes(name.data(), name.size());
+}
+
 template <class T>
 std::shared_ptr<T> with_header(const Header& header) {
   auto message = std::make_shared<T>();
@@ -90,12 +119,12 @@ std::shared_ptr<T> with_header(const Header& header) {
 std::vector<Frame> encode_video(const VideoFrame& m) {
   const ImageBuffer& image = m.image;
   Writer meta;
-  meta.put<std::int32_t>(m.camera_id);
   meta.put<std::uint32_t>(static_cast<std::uint32_t>(image.width()));
   meta.put<std::uint32_t>(static_cast<std::uint32_t>(image.height()));
   meta.put<std::uint32_t>(static_cast<std::uint32_t>(image.stride()));
   meta.put<std::uint8_t>(static_cast<std::uint8_t>(image.format()));
-  meta.put_bytes("\0\0\0", 3);
+  meta.put_bytes("\0", 1);
+  put_camera_name(meta, m.camera, "VideoFrame");
   std::vector<Frame> frames;
   frames.push_back(std::move(meta).frame());
   frames.push_back(Frame{image.data(), image.size_bytes(), image.owner()});  // no copy
@@ -108,6 +137,7 @@ std::vector<Frame> encode_people_2d(const People2D& m) {
   meta.put<std::uint16_t>(static_cast<std::uint16_t>(m.layout));
   meta.put<std::uint16_t>(static_cast<std::uint16_t>(joints));
   meta.put<std::uint32_t>(static_cast<std::uint32_t>(m.people.size()));
+  put_camera_name(meta, m.camera, "People2D");
   for (const Person2D& person : m.people) {
     if (person.joints.size() != joints)
       throw WireError("People2D: people with different joint counts");
@@ -131,9 +161,17 @@ std::vector<Frame> encode_people_2d(const People2D& m) {
 std::vector<Frame> encode_people_3d(const People3D& m) {
   Writer meta, positions, rotations, clips, placement;
   meta.put<std::uint32_t>(static_cast<std::uint32_t>(m.people.size()));
+  meta.put<std::uint8_t>(static_cast<std::uint8_t>(m.frame.kind));
+  meta.put<std::uint8_t>(0);
+  if (m.frame.is_world()) {
+    if (!m.frame.camera.empty()) throw WireError("People3D: the world frame with a camera name");
+    meta.put<std::uint16_t>(0);
+  } else {
+    put_camera_name(meta, m.frame.camera, "People3D");
+  }
   placement.put<std::uint32_t>(m.has_ground ? 1u : 0u);
-  for (int i = 0; i < 3; ++i) placement.put<float>(m.ground.normal[i]);
-  placement.put<float>(m.ground.offset);
+  for (int i = 0; i < 3; ++i) placement.put<float>(static_cast<float>(m.ground.normal[i]));
+  placement.put<float>(static_cast<float>(m.ground.offset));
   for (const Person3D& p : m.people) {
     meta.put<std::int32_t>(p.id);
     meta.put<std::int32_t>(p.provenance.view);
@@ -169,6 +207,7 @@ std::vector<Frame> encode_people_3d(const People3D& m) {
 std::vector<Frame> encode_pose_matches(const PoseMatches& m) {
   Writer meta, body, normalized, candidates;
   meta.put<std::uint32_t>(static_cast<std::uint32_t>(m.people.size()));
+  put_camera_name(meta, m.camera, "PoseMatches");
   for (const PersonMatch& p : m.people) {
     if (p.candidates.size() > kMaxCandidates) throw WireError("PoseMatches: too many candidates");
     meta.put<std::int32_t>(p.id);
@@ -223,11 +262,11 @@ std::vector<Frame> encode_stats(const GraphStats& m) {
 Packet decode_video(const Header& header, std::span<const Frame> payload) {
   Reader meta(payload[0], "VideoFrame meta");
   auto m = with_header<VideoFrame>(header);
-  m->camera_id = meta.get<std::int32_t>();
   const auto width = meta.get<std::uint32_t>(), height = meta.get<std::uint32_t>();
   const auto stride = meta.get<std::uint32_t>();
   const auto format = pixel_format_from_code(meta.get<std::uint8_t>());
-  meta.skip(3);
+  meta.skip(1);
+  m->camera = meta.get_camera_name("VideoFrame");
   meta.expect_end();
   if (!format) throw WireError("VideoFrame: unknown pixel format");
   if (width > kMaxImageSide || height > kMaxImageSide || stride > kMaxImageSide * 4) {
@@ -252,7 +291,8 @@ Packet decode_people_2d(const Header& header, std::span<const Frame> payload) {
     throw WireError("People2D: unknown layout");
   if (count > kMaxPeople || joints > kMaxJoints)
     throw WireError("People2D: counts beyond the limits");
-  expect_size(payload[0], 8 + std::size_t{count} * 20, "People2D meta");
+  m->camera = meta.get_camera_name("People2D");
+  expect_size(payload[0], 10 + m->camera.size() + std::size_t{count} * 20, "People2D meta");
   expect_size(payload[1], std::size_t{count} * joints * 12, "People2D keypoints");
   m->layout = static_cast<LayoutId>(layout);
   Reader values(payload[1], "People2D keypoints");
@@ -272,7 +312,17 @@ Packet decode_people_3d(const Header& header, std::span<const Frame> payload) {
   auto m = with_header<People3D>(header);
   const auto count = meta.get<std::uint32_t>();
   if (count > kMaxPeople) throw WireError("People3D: person count beyond the limits");
-  expect_size(payload[0], 4 + std::size_t{count} * 44, "People3D meta");
+  const auto kind = meta.get<std::uint8_t>();
+  meta.skip(1);
+  if (kind == static_cast<std::uint8_t>(CoordinateFrame::Kind::world)) {
+    if (meta.get<std::uint16_t>() != 0) throw WireError("People3D: the world frame with a camera");
+    m->frame = CoordinateFrame::world();
+  } else if (kind == static_cast<std::uint8_t>(CoordinateFrame::Kind::camera)) {
+    m->frame = CoordinateFrame::of_camera(meta.get_camera_name("People3D"));
+  } else {
+    throw WireError("People3D: unknown frame kind " + std::to_string(kind));
+  }
+  expect_size(payload[0], 8 + m->frame.camera.size() + std::size_t{count} * 44, "People3D meta");
   expect_size(payload[1], std::size_t{count} * kBodyJoints * 12, "People3D positions");
   expect_size(payload[2], std::size_t{count} * kBodyJoints * 16, "People3D rotations");
   Reader positions(payload[1], "People3D positions"), rotations(payload[2], "People3D rotations");
@@ -314,7 +364,8 @@ Packet decode_pose_matches(const Header& header, std::span<const Frame> payload)
   auto m = with_header<PoseMatches>(header);
   const auto count = meta.get<std::uint32_t>();
   if (count > kMaxPeople) throw WireError("PoseMatches: person count beyond the limits");
-  expect_size(payload[0], 4 + std::size_t{count} * 28, "PoseMatches meta");
+  m->camera = meta.get_camera_name("PoseMatches");
+  expect_size(payload[0], 6 + m->camera.size() + std::size_t{count} * 28, "PoseMatches meta");
   expect_size(payload[1], std::size_t{count} * kBodyJoints * 12, "PoseMatches body");
   expect_size(payload[2], std::size_t{count} * kNormalizedDims * 4, "PoseMatches normalized");
   Reader body(payload[1], "PoseMatches body"), normalized(payload[2], "PoseMatches normalized");
@@ -458,7 +509,11 @@ Decoded decode(std::span<const Frame> frames) {
   const auto version = reader.get<std::uint16_t>();
   if (version != kVersion) {
     throw WireError("wire format version " + std::to_string(version) +
-                    " is not supported (this program speaks " + std::to_string(kVersion) + ")");
+                    " is not supported (this program speaks " + std::to_string(kVersion) +
+                    (version < kVersion ? "; the sender is older: update it, e.g. "
+                                          "tools/remote/send_keypoints.py, to version " +
+                                              std::to_string(kVersion) + ")"
+                                        : ")"));
   }
   const auto code = reader.get<std::uint16_t>();
   const TypeInfo* info = nullptr;

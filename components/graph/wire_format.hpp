@@ -1,5 +1,5 @@
 #pragma once
-// The wire format between processes, version 2 (docs/wire-format.md): one message is a ZeroMQ
+// The wire format between processes, version 3 (docs/wire-format.md): one message is a ZeroMQ
 // multipart message made of a fixed header frame and type-specific payload frames; image pixels
 // are a frame of their own so they are sent and received without a copy. This file knows
 // nothing of ZeroMQ: frames are byte ranges with an owner that keeps them alive.
@@ -17,7 +17,7 @@
 
 namespace mocap::graph::wire {
 
-inline constexpr std::uint16_t kVersion = 2;
+inline constexpr std::uint16_t kVersion = 3;
 inline constexpr char kMagic[4] = {'M', 'O', 'C', 'P'};
 inline constexpr std::size_t kHeaderBytes = 44;  // without the stream id
 inline constexpr std::size_t kMaxFrames = 8;     // no message type has more payload frames
@@ -36,6 +36,7 @@ enum class TypeCode : std::uint16_t {
 
 // Limits checked before any allocation: bytes from a socket are untrusted.
 inline constexpr std::size_t kMaxStreamIdBytes = 1024;
+inline constexpr std::size_t kMaxCameraNameBytes = 256;
 inline constexpr std::uint32_t kMaxPeople = 4096;
 inline constexpr std::uint32_t kMaxJoints = 256;
 inline constexpr std::uint32_t kMaxImageSide = 32768;

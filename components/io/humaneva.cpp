@@ -216,25 +216,31 @@ glm::dquat quaternion(const json& value, const std::string& path, const std::str
   return q / length;
 }
 
-Camera read_camera(const json& extrinsic, const json& intrinsics, int index,
-                   const std::string& path, const std::string& source) {
-  Camera cam;
-  cam.id = std::string(kCameraNames[index]);
+camera::Camera read_camera(const json& extrinsic, const json& intrinsics, int index,
+                           const std::string& path, const std::string& source) {
+  camera::Camera cam;
+  cam.name = std::string(kCameraNames[index]);
+  cam.width = 640;
+  cam.height = 480;
   const json& id = member(extrinsic, "id", path, source);
-  if (!id.is_string() || id.get<std::string>() != cam.id) {
-    throw InputError(source, path + ".id should be " + cam.id);
+  if (!id.is_string() || id.get<std::string>() != cam.name) {
+    throw InputError(source, path + ".id should be " + cam.name);
   }
-  cam.orientation =
+  // VideoPose3D's orientation rotates camera-frame vectors into the world.
+  const glm::dquat orientation =
       quaternion(member(extrinsic, "orientation", path, source), path + ".orientation", source);
-  cam.centre =
+  const glm::dvec3 centre =
       vector3(member(extrinsic, "translation_mm", path, source), path + ".translation_mm", source) /
       1000.0;
-  const std::string ipath = "approx_intrinsics_fitted." + cam.id;
-  const json& k = member(intrinsics, cam.id, "approx_intrinsics_fitted", source);
+  cam.set_pose_from_centre(glm::mat3_cast(orientation), centre);
+  const std::string ipath = "approx_intrinsics_fitted." + cam.name;
+  const json& k = member(intrinsics, cam.name, "approx_intrinsics_fitted", source);
   cam.fx = number(member(k, "fx", ipath, source), ipath + ".fx", source);
   cam.fy = number(member(k, "fy", ipath, source), ipath + ".fy", source);
   cam.cx = number(member(k, "cx", ipath, source), ipath + ".cx", source);
   cam.cy = number(member(k, "cy", ipath, source), ipath + ".cy", source);
+  if (const std::string p = camera::camera_problem(cam); !p.empty())
+    throw InputError(source, ipath + ": the camera " + p);
   return cam;
 }
 
@@ -331,22 +337,11 @@ Dataset load_dataset(const std::filesystem::path& folder, const LoadOptions& opt
   return d;
 }
 
-glm::dvec3 Camera::to_camera(const glm::dvec3& world) const {
-  return glm::inverse(orientation) * (world - centre);
-}
-
-glm::dvec2 Camera::project(const glm::dvec3& world) const {
-  const glm::dvec3 c = to_camera(world);
-  return {fx * c.x / c.z + cx, fy * c.y / c.z + cy};
-}
-
-std::map<std::string, std::array<Camera, kCameras>> load_cameras(
-    const std::filesystem::path& file) {
+std::map<std::string, camera::Rig> load_cameras(const std::filesystem::path& file) {
   return parse_cameras(read_whole_file(file, 1u << 20), file.string());
 }
 
-std::map<std::string, std::array<Camera, kCameras>> parse_cameras(std::string_view text,
-                                                                  const std::string& source) {
+std::map<std::string, camera::Rig> parse_cameras(std::string_view text, const std::string& source) {
   json doc;
   try {
     doc = json::parse(text);
@@ -356,16 +351,18 @@ std::map<std::string, std::array<Camera, kCameras>> parse_cameras(std::string_vi
   const json& extrinsics = member(doc, "extrinsics", "", source);
   const json& intrinsics = member(doc, "approx_intrinsics_fitted", "", source);
   if (!extrinsics.is_object() || extrinsics.empty()) throw InputError(source, "no extrinsics");
-  std::map<std::string, std::array<Camera, kCameras>> out;
+  std::map<std::string, camera::Rig> out;
   for (const auto& [subject, cameras] : extrinsics.items()) {
     const std::string path = "extrinsics." + subject;
     if (!cameras.is_array() || cameras.size() != kCameras) {
       throw InputError(source, path + " is not a list of 3 cameras");
     }
+    camera::Rig& rig = out[subject];
     for (int k = 0; k < kCameras; ++k) {
-      out[subject][k] =
-          read_camera(cameras[k], intrinsics, k, path + "[" + std::to_string(k) + "]", source);
+      rig.cameras.push_back(
+          read_camera(cameras[k], intrinsics, k, path + "[" + std::to_string(k) + "]", source));
     }
+    rig.floor = GroundPlane{{0.0, 0.0, 1.0}, 0.0};  // the world's Z = 0 plane, Z up
   }
   return out;
 }

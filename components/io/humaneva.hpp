@@ -22,6 +22,7 @@
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
+#include "camera/rig.hpp"
 #include "core/body15.hpp"
 #include "io/npz.hpp"
 
@@ -94,25 +95,13 @@ void attach_positions_2d(Dataset& dataset, const std::filesystem::path& npz,
 Dataset read_positions_3d(const NpzFile& file, const std::string& source);
 void attach_positions_2d(Dataset& dataset, const NpzFile& file, const std::string& source);
 
-struct Camera {
-  std::string id;  // "C1"
-  // Rotates camera-frame vectors into the world frame (VideoPose3D's convention).
-  glm::dquat orientation{1.0, 0.0, 0.0, 0.0};
-  glm::dvec3 centre{0.0};  // metres, world
-  // Approximate pinhole intrinsics in pixels, fitted without distortion (see the README).
-  double fx = 0, fy = 0, cx = 0, cy = 0;
-  int width = 640, height = 480;
-
-  // X_cam = R(q)ᵀ (X_world − centre): x right, y down, z forward (depth).
-  glm::dvec3 to_camera(const glm::dvec3& world) const;
-  glm::dvec2 project(const glm::dvec3& world) const;
-};
-
-// Subject ("S1".."S3") → the three cameras C1..C3. Throws InputError naming the JSON key.
-std::map<std::string, std::array<Camera, kCameras>> load_cameras(const std::filesystem::path& json);
+// Subject ("S1".."S3") → the rig of that subject's session: the three cameras C1..C3 (640x480,
+// the approximate pinhole intrinsics fitted without distortion, see the README; VideoPose3D's
+// orientation and centre as the pose) in HumanEva's world (metres, Z up), the floor its Z = 0
+// plane. Throws InputError naming the JSON key.
+std::map<std::string, camera::Rig> load_cameras(const std::filesystem::path& json);
 // The same from the file's text; `source` names it in messages.
-std::map<std::string, std::array<Camera, kCameras>> parse_cameras(std::string_view text,
-                                                                  const std::string& source);
+std::map<std::string, camera::Rig> parse_cameras(std::string_view text, const std::string& source);
 
 // HumanEva-15 → Body15 with the HumanEva-15 layout of core/keypoint_layout.hpp. Every Body15
 // joint is one HumanEva joint: root = pelvis (torsoDistal), neck = thorax, head = headDistal.

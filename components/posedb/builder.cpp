@@ -278,8 +278,8 @@ void gather(std::vector<ClipFrames>& clips, DatabaseContents& db,
 void project_all(const std::vector<std::array<glm::vec3, kBodyJoints>>& joints,
                  const BuildOptions& options, DatabaseContents& db, const BuildProgress& progress,
                  BuildReport& report) {
-  std::vector<CameraPose> cameras;
-  for (const View& v : db.views) cameras.push_back(camera_pose(v, options.views.root_height_m));
+  std::vector<camera::Camera> cameras;
+  for (const View& v : db.views) cameras.push_back(view_camera(v, options.views.root_height_m));
   db.projections.reserve(joints.size() * cameras.size() * kPoseDims);
   db.projection_records.reserve(joints.size() * cameras.size());
   std::array<glm::vec2, kBodyJoints> image;

@@ -6,14 +6,14 @@
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
+#include "camera/camera.hpp"
 #include "core/body15.hpp"
-#include "posedb/view_set.hpp"
 
 namespace mocap::posedb {
 
-// Projects root-relative joints (metres, person facing +Z) with a pinhole of focal length 1
-// (the scale does not matter after normalisation). Points behind the camera become NaN.
-void project_body(const std::array<glm::vec3, kBodyJoints>& joints, const CameraPose& camera,
+// Projects root-relative joints (metres, person facing +Z) through a view's camera (view_camera:
+// focal length 1, no distortion), in float. Points behind the camera become NaN.
+void project_body(const std::array<glm::vec3, kBodyJoints>& joints, const camera::Camera& camera,
                   std::array<glm::vec2, kBodyJoints>& out);
 
 }  // namespace mocap::posedb

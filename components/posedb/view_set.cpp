@@ -5,10 +5,11 @@
 
 #include <glm/geometric.hpp>
 #include <glm/mat3x3.hpp>
+#include <glm/trigonometric.hpp>
 
 namespace mocap::posedb {
 
-CameraPose camera_pose(const View& view, float root_height_m) {
+camera::Camera view_camera(const View& view, float root_height_m) {
   const float yaw = glm::radians(view.yaw_deg);
   // Yaw 0: the camera stands on the +Z axis, in front of a person who faces +Z.
   const glm::vec3 position(view.distance_m * std::sin(yaw), view.height_m - root_height_m,
@@ -25,7 +26,12 @@ CameraPose camera_pose(const View& view, float root_height_m) {
   m[0] = glm::vec3(right.x, down.x, forward.x);
   m[1] = glm::vec3(right.y, down.y, forward.y);
   m[2] = glm::vec3(right.z, down.z, forward.z);
-  return {glm::quat_cast(m), position};
+  camera::Camera camera;
+  camera.name = "view";
+  camera.fx = camera.fy = 1.0;
+  camera.rotation = glm::dmat3(m);
+  camera.translation = -(camera.rotation * glm::dvec3(position));
+  return camera;
 }
 
 std::vector<View> make_views(const ViewSetOptions& o) {

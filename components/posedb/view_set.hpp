@@ -5,8 +5,7 @@
 #include <string>
 #include <vector>
 
-#include <glm/gtc/quaternion.hpp>
-#include <glm/vec3.hpp>
+#include "camera/camera.hpp"
 
 namespace mocap::posedb {
 
@@ -30,12 +29,10 @@ struct ViewSetOptions {
 
 std::vector<View> make_views(const ViewSetOptions& options);
 
-// World-to-camera rotation and camera position for a view (camera looks at the root; image x
-// right, y down, z forward as OpenCV).
-struct CameraPose {
-  glm::quat world_to_camera;
-  glm::vec3 position;
-};
-CameraPose camera_pose(const View& view, float root_height_m);
+// The virtual camera of a view: looking at the root (at the origin), image x right, y down, z
+// forward as OpenCV, focal length 1 and principal point 0 (the normalised image; the scale does
+// not matter after normalisation), no image size. Throws std::invalid_argument for a camera
+// straight above the root (no yaw is defined).
+camera::Camera view_camera(const View& view, float root_height_m);
 
 }  // namespace mocap::posedb

@@ -96,7 +96,7 @@ std::optional<BvhPlacement> bvh_placement(const People3D& people, const Person3D
   }
   // World axes in camera coordinates: up is the floor's normal, -Z the camera's forward direction
   // along the floor.
-  const glm::vec3 up = glm::normalize(people.ground.normal);
+  const glm::vec3 up = glm::normalize(glm::vec3(people.ground.normal));
   const glm::vec3 forward(0.0f, 0.0f, 1.0f);
   glm::vec3 along = forward - glm::dot(forward, up) * up;
   if (glm::length(along) < 1e-3f) along = glm::vec3(0.0f, 1.0f, 0.0f);  // looking straight down
@@ -104,7 +104,7 @@ std::optional<BvhPlacement> bvh_placement(const People3D& people, const Person3D
   const glm::vec3 x = glm::cross(up, z);
   const glm::mat3 world_from_camera = glm::transpose(glm::mat3(x, up, z));  // rows x, up, z
   out.root_m = world_from_camera * person.root.translation;
-  out.root_m.y += people.ground.offset;  // the height over the floor
+  out.root_m.y += static_cast<float>(people.ground.offset);  // the height over the floor
   out.height_known = true;
   out.world_from_level = glm::quat_cast(world_from_camera * glm::transpose(level_from_camera));
   return out;

@@ -44,7 +44,9 @@ struct BvhPlacement {
   bool height_known = false;  // false: no floor, the root height stays the mocap's
 };
 
-// The placement of `person` in a frame of `people`; nullopt when the person is not placed.
+// The placement of `person` in a frame of `people`; nullopt when the person is not placed. For
+// people in a camera's frame (People3D::frame): the level world is made from the camera and the
+// floor; a message in the rig's world would already be in one (issue 19's multi-view BVH).
 std::optional<BvhPlacement> bvh_placement(const People3D& people, const Person3D& person);
 
 // Writes database poses as channel values for one skeleton (the first clip's, when a person's

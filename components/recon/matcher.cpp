@@ -55,8 +55,8 @@ float person_distance(const posedb::Database& db, const Candidate& c,
   for (int b = 0; b < kBodyJoints; ++b) body[b] = {j[3 * b], j[3 * b + 1], j[3 * b + 2]};
   if (person) body = motion::retarget(body, *person);
   if (layout) apply_layout_offsets_3d(*layout, body, -1.0f);
-  const posedb::CameraPose camera =
-      posedb::camera_pose(db.views()[c.view], db.build_info().views.root_height_m);
+  const camera::Camera camera =
+      posedb::view_camera(db.views()[c.view], db.build_info().views.root_height_m);
   std::array<glm::vec2, kBodyJoints> image;
   posedb::project_body(body, camera, image);
   posedb::PoseVector row;

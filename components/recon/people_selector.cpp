@@ -53,7 +53,7 @@ struct PeopleSelector::State {
         options.refine_view && query != pending->query.end())
       turned = refined_pose_in_camera(db, *choice, query->second);
     if (const auto root = pending->root_pixel.find(id);
-        options.camera.valid() && root != pending->root_pixel.end())
+        options.camera.has_intrinsics() && root != pending->root_pixel.end())
       turn_onto_ray(turned, options.camera, root->second);
     pending->out.people.push_back(to_person(id, turned));
     if (const auto body = pending->keypoints.find(id); body != pending->keypoints.end())
@@ -107,15 +107,14 @@ std::vector<People3D> PeopleSelector::push(const PoseMatches& in) {
   State& s = *state_;
   State::Pending pending;
   pending.out.header = in.header;
+  pending.out.frame = CoordinateFrame::of_camera(in.camera);
   std::vector<int> ids;
   for (const PersonMatch& person : in.people) {
     if (person.id < 0) continue;  // untracked: no history to choose with
     ids.push_back(person.id);
     pending.keypoints[person.id] = person.body;
     const Keypoint2D& root = person.body[index(Joint::root)];
-    glm::vec2 pixel(root.x, root.y);
-    if (s.options.undistort) pixel = s.options.undistort(pixel);
-    pending.root_pixel[person.id] = pixel;
+    pending.root_pixel[person.id] = glm::vec2(s.options.camera.undistort_pixel({root.x, root.y}));
     if (person.normalized_ok) {
       posedb::PoseVector query;
       std::copy(person.normalized.begin(), person.normalized.end(), query.begin());

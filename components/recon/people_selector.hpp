@@ -3,11 +3,11 @@
 // recon.temporal_selector): the matcher's candidates per frame in (PoseMatches), one People3D per
 // input frame out, in order, each tracked person's chosen candidate turned into a 3D body in the
 // camera frame (view refined against the person's 2D pose, turned onto the ray through their
-// root pixel) with the 2D keypoints it came from. A frame leaves once every person in it is
+// root pixel) with the 2D keypoints it came from; each People3D is in the frame of the
+// PoseMatches' camera. A frame leaves once every person in it is
 // decided (HeldFrames): at once (greedy, nearest) or `lag` frames later (path).
 
 #include <array>
-#include <functional>
 #include <map>
 #include <memory>
 #include <vector>
@@ -29,9 +29,9 @@ struct PeopleSelectorOptions {
   PathOptions path;
   int lag = 8;          // path: frames of look-ahead before a frame is decided
   int max_missed = 10;  // frames a person may be missing before their state is dropped
-  Pinhole camera;       // invalid: the poses stay as the database cameras see them
-  // A root pixel as the pinhole camera sees it (a lens' undistortion); empty: unchanged.
-  std::function<glm::vec2(glm::vec2)> undistort;
+  // Without intrinsics the poses stay as the database cameras see them; with them each pose is
+  // turned onto the ray through its root pixel (undistorted by the camera's lens).
+  camera::Camera camera;
   bool refine_view = true;
 };
 

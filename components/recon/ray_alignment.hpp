@@ -8,8 +8,12 @@
 #include <glm/gtc/quaternion.hpp>
 #include <glm/vec2.hpp>
 
+#include "camera/camera.hpp"
+
 namespace mocap::recon {
 
+// The intrinsics components/fit takes (in float). Only the fitting uses it while it is being
+// rewritten; everything else takes camera::Camera, and the fitting will too.
 struct Pinhole {
   float fx = 0, fy = 0, cx = 0, cy = 0;  // pixels
   bool valid() const { return fx > 0 && fy > 0; }
@@ -18,9 +22,13 @@ struct Pinhole {
   static Pinhole from_fov(int width, int height, float hfov_deg);
 };
 
+// The intrinsics of `camera` for the fitting.
+Pinhole pinhole_of(const camera::Camera& camera);
+
 // The rotation taking a pose expressed in a camera that looks at the root (x horizontal) into the
-// frame of `camera`, which sees the root at `root_pixel`. Assumes the camera has no roll (its x
-// axis horizontal), as the database's cameras.
-glm::quat ray_alignment(const Pinhole& camera, glm::vec2 root_pixel);
+// frame of `camera`, which sees the root at `root_pixel` (undistorted: the pinhole's pixel).
+// Assumes the camera has no roll (its x axis horizontal), as the database's cameras. Identity
+// for a camera without intrinsics.
+glm::quat ray_alignment(const camera::Camera& camera, glm::vec2 root_pixel);
 
 }  // namespace mocap::recon

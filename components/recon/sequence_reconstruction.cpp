@@ -39,11 +39,12 @@ Pose3D pose_in_camera(const posedb::Database& db, const Candidate& chosen,
   Pose3D pose;
   pose.valid = true;
   pose.chosen = chosen;
-  const posedb::CameraPose camera = posedb::camera_pose(view, db.build_info().views.root_height_m);
-  pose.body_to_camera = camera.world_to_camera;
+  const camera::Camera camera = posedb::view_camera(view, db.build_info().views.root_height_m);
+  // The view's rotation was made in float (view_set.cpp): this is that rotation exactly.
+  pose.body_to_camera = glm::quat_cast(glm::mat3(camera.rotation));
   const auto j = db.joints(chosen.frame);
   for (int b = 0; b < kBodyJoints; ++b) {
-    pose.joints[b] = camera.world_to_camera * glm::vec3(j[3 * b], j[3 * b + 1], j[3 * b + 2]);
+    pose.joints[b] = pose.body_to_camera * glm::vec3(j[3 * b], j[3 * b + 1], j[3 * b + 2]);
   }
   return pose;
 }
@@ -59,7 +60,7 @@ Pose3D refined_pose_in_camera(const posedb::Database& db, const Candidate& chose
   return pose_in_camera(db, chosen, view);
 }
 
-void turn_onto_ray(Pose3D& pose, const Pinhole& camera, glm::vec2 root_pixel) {
+void turn_onto_ray(Pose3D& pose, const camera::Camera& camera, glm::vec2 root_pixel) {
   const glm::quat turn = ray_alignment(camera, root_pixel);
   for (auto& joint : pose.joints) joint = turn * joint;
   pose.body_to_camera = turn * pose.body_to_camera;
@@ -153,7 +154,7 @@ std::vector<Pose3D> reconstruct_sequence(Matcher& matcher, const FrameBones& bon
       }
     }
   }
-  if (options.camera.valid()) {
+  if (options.camera.has_intrinsics()) {
     for (std::size_t t = 0; t < frames.size(); ++t) {
       if (!poses[t].valid) continue;
       const glm::vec2 root(frames[t][3 * index(Joint::root)],

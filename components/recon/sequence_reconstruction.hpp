@@ -35,8 +35,9 @@ struct SequenceOptions {
   int sg_order = 3;
   int sg_window = 11;
   double fps = 24.0;
-  // When valid, every pose is turned onto the ray through its root's pixel (ray_alignment.hpp).
-  Pinhole camera;
+  // With intrinsics, every pose is turned onto the ray through its root's pixel
+  // (ray_alignment.hpp); the default camera has none.
+  camera::Camera camera;
   // Search yaw and elevation around the matched view for the best fit (view_refinement.hpp).
   bool refine_view = false;
   // The input layout's keypoints moved onto the canonical joints before matching (the scaler's
@@ -70,7 +71,7 @@ std::vector<Pose3D> reconstruct_sequence(Matcher& matcher, const FrameBones& bon
                                          const SequenceOptions& options);
 
 // Turns a database pose onto the ray through its root pixel as `camera` sees it (ray_alignment).
-void turn_onto_ray(Pose3D& pose, const Pinhole& camera, glm::vec2 root_pixel);
+void turn_onto_ray(Pose3D& pose, const camera::Camera& camera, glm::vec2 root_pixel);
 
 // Smooths the joints of valid poses in place (each run of consecutive valid frames on its own).
 void smooth_sequence(std::vector<Pose3D>& poses, const SequenceOptions& options);

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include <glm/trigonometric.hpp>
+
 #include "posedb/projection.hpp"
 
 namespace mocap::recon {
@@ -12,7 +14,7 @@ namespace {
 float fit_error(const std::array<glm::vec3, kBodyJoints>& body, const posedb::PoseVector& query,
                 const posedb::View& view, float root_height_m, posedb::Scaling scaling) {
   std::array<glm::vec2, kBodyJoints> image;
-  posedb::project_body(body, posedb::camera_pose(view, root_height_m), image);
+  posedb::project_body(body, posedb::view_camera(view, root_height_m), image);
   posedb::PoseVector projected;
   if (!posedb::normalize_pose(image, scaling, projected)) return std::numeric_limits<float>::max();
   float error = 0.0f;

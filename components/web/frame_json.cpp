@@ -34,7 +34,7 @@ std::string hello_json(const std::string& title) {
       -1, ' ', false, Json::error_handler_t::replace);
 }
 
-std::string frame_json(const People3D& frame, const CameraView& camera,
+std::string frame_json(const People3D& frame, const std::optional<ShownCamera>& camera,
                        const std::optional<Playback>& playback, std::optional<double> time) {
   const GroundPlane ground = frame.has_ground ? frame.ground : assumed_ground();
   std::size_t unplaced = 0;
@@ -71,15 +71,17 @@ std::string frame_json(const People3D& frame, const CameraView& camera,
          {rounded(ground.normal.x, 1e4), rounded(ground.normal.y, 1e4),
           rounded(ground.normal.z, 1e4)}},
         {"offset", rounded(ground.offset, 1000)}}}};
-  Json cam = {{"known", camera.known}};
-  if (camera.known) {
-    cam.update({{"assumed", camera.assumed},
-                {"width", camera.width},
-                {"height", camera.height},
-                {"fx", rounded(camera.fx, 10)},
-                {"fy", rounded(camera.fy, 10)},
-                {"cx", rounded(camera.cx, 10)},
-                {"cy", rounded(camera.cy, 10)}});
+  Json cam = {{"known", camera.has_value()}};
+  if (camera) {
+    // In float, as the viewer always had them.
+    const camera::Camera& c = camera->camera;
+    cam.update({{"assumed", camera->assumed},
+                {"width", c.width},
+                {"height", c.height},
+                {"fx", rounded(static_cast<float>(c.fx), 10)},
+                {"fy", rounded(static_cast<float>(c.fy), 10)},
+                {"cx", rounded(static_cast<float>(c.cx), 10)},
+                {"cy", rounded(static_cast<float>(c.cy), 10)}});
   }
   out["camera"] = cam;
   if (playback) {

@@ -17,17 +17,16 @@
 
 #include <glm/vec3.hpp>
 
+#include "camera/camera.hpp"
 #include "core/messages.hpp"
 #include "core/scene.hpp"
 
 namespace mocap::web {
 
-// The camera's intrinsics, when known; the page draws its frustum from them.
-struct CameraView {
-  bool known = false;
+// The camera the page draws, when known: its frustum from the intrinsics.
+struct ShownCamera {
+  camera::Camera camera;
   bool assumed = false;  // from a field of view, not calibrated
-  int width = 0, height = 0;
-  float fx = 0, fy = 0, cx = 0, cy = 0;
 };
 
 struct Playback {
@@ -40,7 +39,7 @@ struct Playback {
 // The greeting each browser gets first: joint names and the bones (pairs of joint indices).
 std::string hello_json(const std::string& title);
 
-std::string frame_json(const People3D& frame, const CameraView& camera,
+std::string frame_json(const People3D& frame, const std::optional<ShownCamera>& camera,
                        const std::optional<Playback>& playback = std::nullopt,
                        std::optional<double> time = std::nullopt);
 

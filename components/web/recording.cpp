@@ -76,10 +76,10 @@ People3D frame_of(const Json& line, std::int64_t number) {
   if (const auto ground = line.find("ground"); ground != line.end()) {
     if (!ground->is_object() || !ground->contains("offset") || !(*ground)["offset"].is_number())
       throw std::invalid_argument("'ground' without a numeric 'offset'");
-    frame.ground.normal = vec3_of(ground->value("normal", Json()), "ground normal");
-    frame.ground.offset = (*ground)["offset"].get<float>();
-    const float length = std::sqrt(glm::dot(frame.ground.normal, frame.ground.normal));
-    if (!(length > 0.5f && length < 2.0f)) throw std::invalid_argument("ground normal not a unit");
+    frame.ground.normal = glm::dvec3(vec3_of(ground->value("normal", Json()), "ground normal"));
+    frame.ground.offset = (*ground)["offset"].get<double>();
+    const double length = glm::length(frame.ground.normal);
+    if (!(length > 0.5 && length < 2.0)) throw std::invalid_argument("ground normal not a unit");
     frame.has_ground = true;
   }
   return frame;

@@ -2,13 +2,13 @@
 
 #include <cmath>
 #include <filesystem>
-#include <numbers>
 #include <random>
 #include <stdexcept>
 #include <string>
 
 #include <gtest/gtest.h>
 
+#include "camera/rig.hpp"
 #include "core/input_error.hpp"
 #include "support/files.hpp"
 
@@ -54,13 +54,15 @@ std::string error_of(const std::string& path) {
 TEST(CameraFile, ReadsOpenCvCalibrationOutput) {
   test::TempDir dir;
   test::write_file(dir.file("cam.yml"), kOpenCvFile);
-  const CameraIntrinsics c = read_camera_file(dir.file("cam.yml"));
+  const Camera c = read_camera_file(dir.file("cam.yml"));
+  EXPECT_EQ(c.name, "cam_01");  // the single-camera file is a one-camera rig
   EXPECT_EQ(c.width, 640);
   EXPECT_EQ(c.height, 480);
-  EXPECT_DOUBLE_EQ(c.fx(), 5.3591573396163199e+02);
-  EXPECT_DOUBLE_EQ(c.cx(), 3.4228315473308373e+02);
-  EXPECT_DOUBLE_EQ(c.cy(), 2.3557082909788173e+02);
-  EXPECT_DOUBLE_EQ(c.K[8], 1.0);
+  EXPECT_DOUBLE_EQ(c.fx, 5.3591573396163199e+02);
+  EXPECT_DOUBLE_EQ(c.cx, 3.4228315473308373e+02);
+  EXPECT_DOUBLE_EQ(c.cy, 2.3557082909788173e+02);
+  EXPECT_EQ(c.rotation, glm::dmat3(1.0));  // its frame is the world
+  EXPECT_EQ(c.translation, glm::dvec3(0.0));
   ASSERT_EQ(c.distortion.size(), 5u);
   EXPECT_DOUBLE_EQ(c.distortion[0], -2.6637260909660682e-01);
   EXPECT_DOUBLE_EQ(c.distortion[4], 2.3839153080878486e-01);
@@ -68,33 +70,23 @@ TEST(CameraFile, ReadsOpenCvCalibrationOutput) {
 
 TEST(CameraFile, WriteThenReadIsEqual) {
   test::TempDir dir;
-  CameraIntrinsics c;
+  Camera c;
+  c.name = "cam_01";
   c.width = 1920;
   c.height = 1080;
-  c.K = {1401.25, 0.0, 961.5, 0.0, 1399.75, 540.125, 0.0, 0.0, 1.0};
+  c.fx = 1401.25;
+  c.fy = 1399.75;
+  c.cx = 961.5;
+  c.cy = 540.125;
   c.distortion = {-0.1, 0.02, 0.001, -0.0005, 0.003};
   write_camera_file(dir.file("c.yaml"), c, 0.25);
   EXPECT_EQ(read_camera_file(dir.file("c.yaml")), c);
   EXPECT_NE(test::read_file(dir.file("c.yaml")).find("avg_reprojection_error"), std::string::npos);
 }
 
-TEST(CameraFile, FromFov) {
-  const CameraIntrinsics c = from_fov(640, 480, 90.0);
-  EXPECT_NEAR(c.fx(), 320.0, 1e-9);
-  EXPECT_NEAR(c.fy(), 320.0, 1e-9);
-  EXPECT_NEAR(c.cx(), 319.5, 1e-12);
-  EXPECT_NEAR(c.cy(), 239.5, 1e-12);
-  EXPECT_EQ(c.distortion, std::vector<double>(5, 0.0));
-  // 60 degrees: f = (w/2) / tan(30 deg).
-  EXPECT_NEAR(from_fov(1000, 500, 60.0).fx(), 500.0 / std::tan(std::numbers::pi / 6), 1e-9);
-  EXPECT_THROW(from_fov(0, 480, 60.0), std::invalid_argument);
-  EXPECT_THROW(from_fov(640, 480, 180.0), std::invalid_argument);
-  EXPECT_THROW(from_fov(640, 480, 0.0), std::invalid_argument);
-}
-
 TEST(CameraFile, FromFovRoundTrips) {
   test::TempDir dir;
-  const CameraIntrinsics c = from_fov(1280, 720, 70.0);
+  const Camera c = Camera::from_fov(1280, 720, 70.0);
   write_camera_file(dir.file("f.yml"), c);
   EXPECT_EQ(read_camera_file(dir.file("f.yml")), c);
 }
@@ -229,17 +221,18 @@ TEST(CameraFileGround, ReadsHeightAndTilt) {
   const std::optional<GroundPlane> plane = read_ground_plane(dir.file("g.yml"));
   ASSERT_TRUE(plane.has_value());
   EXPECT_DOUBLE_EQ(plane->offset, 1.5);
-  EXPECT_DOUBLE_EQ(camera_height_m(*plane), 1.5);
-  EXPECT_NEAR(camera_tilt_deg(*plane), 30.0, 1e-9);
-  EXPECT_NEAR(camera_tilt_deg({{0.0, -1.0, 0.0}, 2.0}), 0.0, 1e-12);   // level camera
-  EXPECT_NEAR(camera_tilt_deg({{0.0, 0.0, -1.0}, 2.0}), 90.0, 1e-12);  // looking straight down
+  const Camera at_origin;  // the plane is in the camera's frame
+  EXPECT_DOUBLE_EQ(height_above_m(at_origin, *plane), 1.5);
+  EXPECT_NEAR(tilt_below_horizon_deg(at_origin, *plane), 30.0, 1e-9);
+  EXPECT_NEAR(tilt_below_horizon_deg(at_origin, {{0.0, -1.0, 0.0}, 2.0}), 0.0, 1e-12);   // level
+  EXPECT_NEAR(tilt_below_horizon_deg(at_origin, {{0.0, 0.0, -1.0}, 2.0}), 90.0, 1e-12);  // down
   // The intrinsics read as before.
-  EXPECT_DOUBLE_EQ(read_camera_file(dir.file("g.yml")).fx(), 5.3591573396163199e+02);
+  EXPECT_DOUBLE_EQ(read_camera_file(dir.file("g.yml")).fx, 5.3591573396163199e+02);
 }
 
 TEST(CameraFileGround, WriteKeepsIntrinsicsAndError) {
   test::TempDir dir;
-  CameraIntrinsics c = from_fov(1280, 720, 70.0);
+  Camera c = Camera::from_fov(1280, 720, 70.0);
   c.distortion = {-0.1, 0.02, 0.001, -0.0005, 0.003};
   write_camera_file(dir.file("c.yml"), c, 0.375);
   EXPECT_FALSE(read_ground_plane(dir.file("c.yml")).has_value());

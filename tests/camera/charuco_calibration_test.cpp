@@ -74,9 +74,9 @@ TEST(CharucoCalibration, RecoversTheSyntheticCamera) {
   options.board = board_5x7();
   const std::vector<std::string> files = write_views(dir, options.board);
   const BoardCalibration result = calibrate_charuco_images(files, options);
-  const CameraIntrinsics& c = result.camera;
+  const Camera& c = result.camera;
   std::cout << "synthetic ChArUco: RMS " << result.rms_px << " px over " << result.used.size()
-            << " views; fx " << c.fx() << " fy " << c.fy() << " cx " << c.cx() << " cy " << c.cy()
+            << " views; fx " << c.fx << " fy " << c.fy << " cx " << c.cx << " cy " << c.cy
             << " (true 780 770 405 298)\n";
   for (const auto& s : result.skipped)
     std::cout << "  skipped " << s.name << ": " << s.reason << "\n";
@@ -85,10 +85,10 @@ TEST(CharucoCalibration, RecoversTheSyntheticCamera) {
   EXPECT_LT(result.rms_px, 1.0);
   EXPECT_EQ(c.width, 800);
   EXPECT_EQ(c.height, 600);
-  EXPECT_NEAR(c.fx(), 780.0, 0.02 * 780.0);
-  EXPECT_NEAR(c.fy(), 770.0, 0.02 * 770.0);
-  EXPECT_NEAR(c.cx(), 405.0, 0.03 * 405.0);
-  EXPECT_NEAR(c.cy(), 298.0, 0.03 * 298.0);
+  EXPECT_NEAR(c.fx, 780.0, 0.02 * 780.0);
+  EXPECT_NEAR(c.fy, 770.0, 0.02 * 770.0);
+  EXPECT_NEAR(c.cx, 405.0, 0.03 * 405.0);
+  EXPECT_NEAR(c.cy, 298.0, 0.03 * 298.0);
   ASSERT_EQ(c.distortion.size(), 5u);
   EXPECT_NEAR(c.distortion[0], 0.0, 0.1);  // the renderer has no lens distortion
 }
@@ -146,7 +146,7 @@ TEST(CharucoCalibration, Video) {
   EXPECT_GE(result.used.size(), 7u);
   EXPECT_EQ(result.used.front(), video + "#0");
   EXPECT_LT(result.rms_px, 1.0);
-  EXPECT_NEAR(result.camera.fx(), 780.0, 0.03 * 780.0);
+  EXPECT_NEAR(result.camera.fx, 780.0, 0.03 * 780.0);
 }
 
 TEST(CharucoCalibration, BadBoardsAreRejected) {

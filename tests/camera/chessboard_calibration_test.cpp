@@ -37,8 +37,8 @@ TEST(ChessboardCalibration, OpenCvSampleImagesGiveSubPixelError) {
   options.square_mm = 25.0;
   const ChessboardCalibration result = calibrate_chessboard_images(files, options);
   std::cout << "RMS reprojection error " << result.rms_px << " px over " << result.used.size()
-            << " images; fx " << result.camera.fx() << " fy " << result.camera.fy() << " cx "
-            << result.camera.cx() << " cy " << result.camera.cy() << "\n";
+            << " images; fx " << result.camera.fx << " fy " << result.camera.fy << " cx "
+            << result.camera.cx << " cy " << result.camera.cy << "\n";
   EXPECT_GT(result.rms_px, 0.0);
   EXPECT_LT(result.rms_px, 1.0);
   EXPECT_GE(result.used.size(), 10u);
@@ -46,10 +46,10 @@ TEST(ChessboardCalibration, OpenCvSampleImagesGiveSubPixelError) {
   EXPECT_EQ(result.camera.width, 640);
   EXPECT_EQ(result.camera.height, 480);
   // A plausible camera: focal length in pixels ~ 530, principal point near the centre.
-  EXPECT_NEAR(result.camera.fx(), 535.0, 30.0);
-  EXPECT_NEAR(result.camera.fy(), 535.0, 30.0);
-  EXPECT_NEAR(result.camera.cx(), 320.0, 40.0);
-  EXPECT_NEAR(result.camera.cy(), 240.0, 40.0);
+  EXPECT_NEAR(result.camera.fx, 535.0, 30.0);
+  EXPECT_NEAR(result.camera.fy, 535.0, 30.0);
+  EXPECT_NEAR(result.camera.cx, 320.0, 40.0);
+  EXPECT_NEAR(result.camera.cy, 240.0, 40.0);
   EXPECT_EQ(result.camera.distortion.size(), 5u);
 
   test::TempDir dir;

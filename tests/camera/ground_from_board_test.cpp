@@ -16,6 +16,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "camera/chessboard_calibration.hpp"
+#include "camera/rig.hpp"
 #include "core/input_error.hpp"
 #include "support/board_render.hpp"
 #include "support/files.hpp"
@@ -35,7 +36,7 @@ std::vector<std::string> opencv_left_images() {
   return files;
 }
 
-double dot(const std::array<double, 3>& a, const cv::Vec3d& b) {
+double dot(const glm::dvec3& a, const cv::Vec3d& b) {
   return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 }
 
@@ -45,12 +46,13 @@ TEST(GroundFromBoard, RealChessboardPhotoMatchesAnIndependentPose) {
     GTEST_SKIP() << "needs " << kDataDir << "/left01.jpg ... left14.jpg (apt install opencv-doc)";
   ChessboardOptions options;
   options.square_mm = 25.0;
-  const CameraIntrinsics cam = calibrate_chessboard_images(files, options).camera;
+  const Camera cam = calibrate_chessboard_images(files, options).camera;
   BoardSpec board;  // chessboard 9x6 inner corners
   board.square_mm = 25.0;
   const FloorFromBoard floor = ground_from_board_image(files[0], cam, board);
   std::cout << "left01: height " << floor.plane.offset << " m, tilt "
-            << camera_tilt_deg(floor.plane) << " deg, pose RMS " << floor.rms_px << " px\n";
+            << tilt_below_horizon_deg(Camera{}, floor.plane) << " deg, pose RMS " << floor.rms_px
+            << " px\n";
   EXPECT_EQ(floor.corners, 54);
   EXPECT_LT(floor.rms_px, 1.0);
 
@@ -63,7 +65,7 @@ TEST(GroundFromBoard, RealChessboardPhotoMatchesAnIndependentPose) {
   std::vector<cv::Point3d> object;
   for (int r = 0; r < 6; ++r)
     for (int c = 0; c < 9; ++c) object.emplace_back(0.025 * c, 0.025 * r, 0.0);  // metres
-  const cv::Matx33d K(cam.K.data());
+  const cv::Matx33d K(cam.matrix().data());
   cv::Vec3d rvec, tvec;
   ASSERT_TRUE(cv::solvePnP(object, corners, K, cam.distortion, rvec, tvec));
   cv::Matx33d R;
@@ -108,11 +110,14 @@ TEST(GroundFromBoard, SyntheticCharucoRecoversHeightAndTilt) {
   board.dictionary = "DICT_5X5_100";
   const test::CharucoTexture texture =
       test::charuco_texture(7, 5, 100.0, 75.0, cv::aruco::DICT_5X5_100, 80);
-  CameraIntrinsics cam;
+  Camera cam;
+  cam.name = "cam_01";
   cam.width = size.width;
   cam.height = size.height;
-  for (int i = 0; i < 9; ++i) cam.K[i] = K.val[i];
-  cam.distortion.assign(5, 0.0);
+  cam.fx = K(0, 0);
+  cam.fy = K(1, 1);
+  cam.cx = K(0, 2);
+  cam.cy = K(1, 2);
 
   test::TempDir dir;
   const FloorScene scenes[] = {{1.2, 40.0, 1.4, 5.0}, {2.0, 35.0, 2.2, 0.0}, {0.8, 55.0, 0.6, 0.0}};
@@ -137,10 +142,12 @@ TEST(GroundFromBoard, SyntheticCharucoRecoversHeightAndTilt) {
     cv::imwrite(file, test::render_board(texture, K, size, rvec, tvec, 3));
     const FloorFromBoard floor = ground_from_board_image(file, cam, board, s.thickness_mm);
     std::cout << "synthetic floor: true height " << s.height_m << " m tilt " << s.tilt_deg
-              << " deg -> " << camera_height_m(floor.plane) << " m " << camera_tilt_deg(floor.plane)
-              << " deg (" << floor.corners << " corners, RMS " << floor.rms_px << " px)\n";
-    EXPECT_NEAR(camera_height_m(floor.plane), s.height_m, 0.01);
-    EXPECT_NEAR(camera_tilt_deg(floor.plane), s.tilt_deg, 0.5);
+              << " deg -> " << height_above_m(Camera{}, floor.plane) << " m "
+              << tilt_below_horizon_deg(Camera{}, floor.plane) << " deg (" << floor.corners
+              << " corners, RMS " << floor.rms_px << " px)\n";
+    // The plane is in the camera's frame: the camera at the origin.
+    EXPECT_NEAR(height_above_m(Camera{}, floor.plane), s.height_m, 0.01);
+    EXPECT_NEAR(tilt_below_horizon_deg(Camera{}, floor.plane), s.tilt_deg, 0.5);
     // The floor normal is the world's up, seen from the camera: (0, -cos, -sin).
     EXPECT_NEAR(floor.plane.normal[0], 0.0, 0.01);
     EXPECT_NEAR(floor.plane.normal[1], -std::cos(t), 0.01);
@@ -150,7 +157,7 @@ TEST(GroundFromBoard, SyntheticCharucoRecoversHeightAndTilt) {
 
 TEST(GroundFromBoard, ErrorsNameTheImage) {
   test::TempDir dir;
-  const CameraIntrinsics cam = from_fov(640, 480, 60.0);
+  const Camera cam = Camera::from_fov(640, 480, 60.0);
   BoardSpec board;
   test::write_file(dir.file("bad.jpg"), "garbage");
   try {

@@ -88,7 +88,7 @@ TEST_F(AravisSourceTest, EmitsFramesWithHeaders) {
     EXPECT_EQ(seen[i].format, PixelFormat::gray8);
     EXPECT_EQ(seen[i].header.seq, i);
     EXPECT_EQ(seen[i].header.frame, static_cast<std::int64_t>(i));
-    EXPECT_EQ(seen[i].header.stream, "camera0");
+    EXPECT_EQ(seen[i].header.stream, "cam_01");  // the camera's name (kDefaultCamera)
     if (i > 0) {
       EXPECT_GT(seen[i].header.capture_ns, seen[i - 1].header.capture_ns);
     }

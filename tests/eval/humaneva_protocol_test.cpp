@@ -42,8 +42,10 @@ TEST(HumanEvaProtocol, TableMeansCellsAndSumsFrames) {
   a.pa_mpjpe_sum = 20;  // 10 mm
   b.frames = b.valid = 6;
   b.pa_mpjpe_sum = 180;  // 30 mm
-  table.add({"S1", "Walk", "", "C1", {}, {}, {}}, a);
-  table.add({"S2", "Box", "", "C1", {}, {}, {}}, b);
+  camera::Camera c1;
+  c1.name = "C1";
+  table.add({"S1", "Walk", "", c1, {}, {}}, a);
+  table.add({"S2", "Box", "", c1, {}, {}}, b);
   EXPECT_DOUBLE_EQ(table.cell("S1", "Walk").pa_mpjpe(), 10.0);
   EXPECT_DOUBLE_EQ(table.mean_cell_pa_mpjpe(), 20.0);  // cells count once each
   EXPECT_DOUBLE_EQ(table.all().pa_mpjpe(), 25.0);      // every frame counts once
@@ -101,13 +103,13 @@ TEST_F(HumanEvaProtocolShared, ValidationInputAndTruthAgreeAtTheEvaluationRate) 
   const auto& first = sequences.front();
   EXPECT_EQ(first.subject, "S1");
   EXPECT_EQ(first.action, "Walk");
-  EXPECT_EQ(first.camera, "C1");
+  EXPECT_EQ(first.camera.name, "C1");
   const he::Chunk* chunk = data_->select(he::Split::validate, "S1", "Walking").front();
   EXPECT_EQ(first.input.size(), static_cast<std::size_t>((chunk->frames() - 1) / 2.5) + 1);
   ASSERT_EQ(first.input.size(), first.truth_camera.size());
   // The truth projected with the fitted intrinsics lands on the 2D input (the README's residual
   // is about a pixel; interpolation and distortion stay well under 10).
-  const he::Camera& camera = cameras_->at("S1")[0];
+  const camera::Camera& camera = cameras_->at("S1").cameras.at(0);
   std::vector<double> residuals;
   for (std::size_t t = 0; t < first.input.size(); ++t) {
     for (int j = 0; j < kBodyJoints; ++j) {

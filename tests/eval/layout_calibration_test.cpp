@@ -6,6 +6,7 @@
 #include <glm/geometric.hpp>
 #include <glm/gtc/quaternion.hpp>
 
+#include "camera/rig_file.hpp"
 #include "core/input_error.hpp"
 #include "support/shared_data.hpp"
 
@@ -66,7 +67,7 @@ TEST(LayoutCalibration, Pose2SimBody25bLandsCloserToTheJointCentres) {
   ASSERT_EQ(frames.size(), 100u);
   const LayoutFit fit =
       fit_layout_offsets(LayoutId::body25b, frames, default_bases(LayoutId::body25b));
-  const auto cameras = camera::read_pose2sim_calibration(dir / "calibration/Calib_qualisys.toml");
+  const auto cameras = camera::read_rig(dir / "calibration/Calib_qualisys.toml").cameras;
   ASSERT_EQ(cameras.size(), 4u);
   const auto check = evaluate_offsets_2d(fit.offsets, frames, cameras);
   double before = 0, after = 0;
@@ -93,7 +94,7 @@ TEST(LayoutCalibration, Pose2SimCamerasRejectTruncation) {
   const std::string file = dir.file("cut.toml");
   test::write_file(file, text.substr(0, text.find("rotation")));
   try {
-    camera::read_pose2sim_calibration(file);
+    camera::read_rig(file);
     ADD_FAILURE() << "no error";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find(file), std::string::npos) << e.what();

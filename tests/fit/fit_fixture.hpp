@@ -34,6 +34,11 @@ inline recon::Pinhole fit_camera() {
   const eval::Image image;
   return recon::Pinhole::from_fov(image.width, image.height, image.horizontal_fov_deg);
 }
+// The same camera for the retrieval (recon::SequenceOptions).
+inline camera::Camera fit_lens() {
+  const eval::Image image;
+  return camera::Camera::from_fov(image.width, image.height, image.horizontal_fov_deg);
+}
 
 struct FitScene {
   std::vector<eval::Body> world;

@@ -105,7 +105,7 @@ TEST(SkeletonFit, ConvergesFromRetrievedPosesWithNoisy2D) {
   const recon::FrameBones bones(db);
   recon::SequenceOptions so;
   so.selection = recon::Selection::path;
-  so.camera = test::fit_camera();
+  so.camera = test::fit_lens();
   const auto retrieved = recon::reconstruct_sequence(matcher, bones, s.rendered.input, so);
   const fit::ContactDetector detector(db);
   const auto contacts = detector.contacts(retrieved);

@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 #include <glm/gtc/quaternion.hpp>
+#include <glm/matrix.hpp>
 
 #include "eval/crossview.hpp"
 #include "eval/humaneva_protocol.hpp"
@@ -24,9 +25,13 @@ constexpr glm::dvec3 kUp{0.0, 0.0, 1.0};
 struct View {
   std::vector<recon::BodyXyc> input;
   std::vector<eval::Body> truth_camera;
-  recon::Pinhole intrinsics;
+  camera::Camera intrinsics;  // the retrieval's camera; the fit takes its pinhole
   CameraPose camera;
 };
+
+CameraPose pose_of(const camera::Camera& c) {
+  return {glm::quat_cast(glm::transpose(c.rotation)), c.centre()};
+}
 
 struct Outcome {
   std::vector<ViewFits> fits;
@@ -47,7 +52,7 @@ Outcome run(const posedb::Database& db, const std::vector<View>& views) {
     retrieval_options.smoothing = recon::Smoothing::savitzky_golay;
     retrieval_options.camera = v.intrinsics;
     FitOptions options;
-    options.camera = v.intrinsics;
+    options.camera = recon::pinhole_of(v.intrinsics);
     options.ground = GroundPlane{kUp, 0.0};
     out.fits.push_back(reconstruct_and_fit(matcher, bones, &contacts, v.input, v.camera,
                                            retrieval_options, options, {true, true}));
@@ -91,9 +96,8 @@ TEST(ViewFit, HumanEvaChunkSeenByItsThreeCameras) {
   std::vector<View> views;
   for (int c = 0; c < 3; ++c) {
     const auto& s = sequences[first + c];
-    const auto& cam = cameras.at(s.subject)[c];
-    ASSERT_EQ(s.camera, cam.id);
-    View v{s.input, s.truth_camera, s.intrinsics, {cam.orientation, cam.centre}};
+    ASSERT_EQ(s.camera.name, cameras.at(s.subject).cameras.at(c).name);
+    View v{s.input, s.truth_camera, s.camera, pose_of(s.camera)};
     v.input.resize(24);
     v.truth_camera.resize(24);
     views.push_back(v);
@@ -124,13 +128,9 @@ TEST(ViewFit, Pose2SimBalancingTrialSeenByItsFourCameras) {
   const double fps = db.build_info().fps;
   std::vector<View> views;
   for (const auto& v : trial.views) {
-    const auto& k = v.camera.intrinsics;
-    const glm::dmat3 to_world = glm::transpose(v.camera.rotation_matrix());
     views.push_back({eval::resample_keypoints(v.input, trial.fps, fps),
-                     eval::resample_bodies(v.truth_camera, trial.fps, fps),
-                     {static_cast<float>(k.fx()), static_cast<float>(k.fy()),
-                      static_cast<float>(k.cx()), static_cast<float>(k.cy())},
-                     {glm::quat_cast(to_world), v.camera.centre()}});
+                     eval::resample_bodies(v.truth_camera, trial.fps, fps), v.camera,
+                     pose_of(v.camera)});
   }
   ASSERT_EQ(views.size(), 4u);
   EXPECT_EQ(views[0].input.size(), 16u);

@@ -1,5 +1,5 @@
-// Fuzz target: HumanEva camera JSON (io/humaneva.hpp parse_cameras). Cameras that read must
-// project a point in front of them without crashing.
+// Fuzz target: HumanEva camera JSON (io/humaneva.hpp parse_cameras). The rigs that read must be
+// usable and their cameras project a point in front of them without crashing.
 
 #include "core/input_error.hpp"
 #include "fuzz_support.hpp"
@@ -10,8 +10,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::string name = "fuzz-input.json";
   try {
     const auto subjects = io::humaneva::parse_cameras(fuzz::text(data, size), name);
-    for (const auto& [subject, cameras] : subjects)
-      for (const auto& c : cameras) (void)c.project(c.centre + glm::dvec3(0.0, 0.0, 1.0));
+    for (const auto& [subject, rig] : subjects) {
+      fuzz::check(camera::rig_problem(rig).empty(), "a camera with a problem was accepted");
+      for (const auto& c : rig.cameras) (void)c.project(c.centre() + c.optical_axis());
+    }
   } catch (const InputError& e) {
     fuzz::expect_named(e, name);
   }

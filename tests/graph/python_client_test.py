@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """A program in another language reads a mocap stream: Python with Debian's python3-zmq subscribes
 to sink.publish and decodes People2D, VideoFrame and EndOfStream messages by docs/wire-format.md
-alone (struct, no mocap code).
+alone (struct, no mocap code), version 3: each message says its camera.
 
 usage: python_client_test.py MOCAP_BINARY      exit 0 pass, 1 fail, 77 skipped
 """
@@ -26,23 +26,27 @@ BYTES_PER_PIXEL = {1: 1, 2: 3, 3: 3, 4: 4, 5: 4}
 def decode(parts):
     magic, version, kind, seq, capture_ns, frame, send_ns, stream_len, count = HEADER.unpack_from(parts[0])
     assert magic == b"MOCP", magic
-    assert version == 2, version
+    assert version == 3, version
     assert len(parts[0]) == HEADER.size + stream_len
     assert len(parts) == count + 1
     message = {"type": kind, "seq": seq, "frame": frame, "capture_ns": capture_ns,
                "stream": parts[0][HEADER.size:].decode()}
     if kind == PEOPLE_2D:
-        layout, joints, people = struct.unpack_from("<HHI", parts[1])
-        assert len(parts[1]) == 8 + 20 * people and len(parts[2]) == 12 * people * joints
+        layout, joints, people, name_len = struct.unpack_from("<HHIH", parts[1])
+        message["camera"] = parts[1][10:10 + name_len].decode()
+        records = 10 + name_len
+        assert len(parts[1]) == records + 20 * people and len(parts[2]) == 12 * people * joints
         values = struct.unpack("<%df" % (3 * people * joints), parts[2])
         message["people"] = []
         for p in range(people):
-            person_id, bx, by, bw, bh = struct.unpack_from("<iffff", parts[1], 8 + 20 * p)
+            person_id, bx, by, bw, bh = struct.unpack_from("<iffff", parts[1], records + 20 * p)
             keypoints = [values[3 * (p * joints + j):3 * (p * joints + j) + 3] for j in range(joints)]
             message["people"].append({"id": person_id, "box": (bx, by, bw, bh), "joints": keypoints})
         message["layout"] = layout
     elif kind == VIDEO_FRAME:
-        camera, width, height, stride, pixel_format = struct.unpack_from("<iIIIB", parts[1])
+        width, height, stride, pixel_format, _, name_len = struct.unpack_from("<IIIBBH", parts[1])
+        assert len(parts[1]) == 16 + name_len
+        camera = parts[1][16:16 + name_len].decode()
         assert len(parts[2]) == stride * height
         assert stride >= width * BYTES_PER_PIXEL[pixel_format]
         message.update(camera=camera, width=width, height=height, stride=stride,
@@ -71,7 +75,7 @@ def main():
             f.write(f"""
 nodes:
   src:    {{ type: test.counter, params: {{ count: 40, people: 2, interval_ms: 2 }} }}
-  cam:    {{ type: test.frames, params: {{ count: 5, width: 64, height: 48 }} }}
+  cam:    {{ type: test.frames, params: {{ count: 5, width: 64, height: 48, camera: left }} }}
   people: {{ type: sink.publish, params: {{ endpoint: "{people_endpoint}", wait_for_subscriber: true }} }}
   frames: {{ type: sink.publish, params: {{ endpoint: "{frames_endpoint}", wait_for_subscriber: true }} }}
 edges:
@@ -104,6 +108,7 @@ edges:
     for m in people:
         assert m["stream"] == "counter" and m["frame"] == m["seq"] and m["capture_ns"] > 0
         assert m["layout"] == 0 and len(m["people"]) == 2
+        assert m["camera"] == "cam_01", m["camera"]  # a single-camera graph's default name
         for p, person in enumerate(m["people"]):
             assert person["id"] == p and len(person["joints"]) == 17
             x, y, c = person["joints"][4]
@@ -112,6 +117,7 @@ edges:
     assert [m["seq"] for m in frames] == list(range(5))
     for m in frames:
         assert (m["width"], m["height"], m["stride"]) == (64, 48, 192)
+        assert m["camera"] == "left" and m["stream"] == "left", (m["camera"], m["stream"])
         for row in (0, 47):
             assert m["pixels"][row * 192] == (m["seq"] + row) % 256
     print("decoded %d People2D and %d VideoFrame messages from Python" % (len(people), len(frames)))

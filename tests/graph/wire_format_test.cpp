@@ -24,6 +24,7 @@ std::shared_ptr<People2D> people_2d() {
   auto m = std::make_shared<People2D>();
   m->header = header(7);
   m->layout = LayoutId::body25;
+  m->camera = "left cam";
   for (int p = 0; p < 3; ++p) {
     Person2D person;
     person.id = p - 1;
@@ -48,15 +49,16 @@ std::shared_ptr<People3D> people_3d() {
   person.placed = true;
   person.keypoints[3] = {640.5f, 360.25f, 0.75f};
   m->people = {person, Person3D{}};
+  m->frame = CoordinateFrame::of_camera("cam_02");
   m->has_ground = true;
-  m->ground = {{0.0f, -0.96f, 0.28f}, 1.6f};
+  m->ground = {glm::dvec3(glm::vec3(0.0f, -0.96f, 0.28f)), 1.6};
   return m;
 }
 
 std::shared_ptr<VideoFrame> video_frame() {
   auto m = std::make_shared<VideoFrame>();
   m->header = header(3);
-  m->camera_id = 2;
+  m->camera = "cam_03";
   m->image = ImageBuffer(64, 48, PixelFormat::bgr8);
   auto pixels = m->image.pixels_for_writing();
   for (std::size_t i = 0; i < pixels.size(); ++i) pixels[i] = static_cast<std::byte>(i * 7);
@@ -84,6 +86,7 @@ TEST(WireFormat, People2DRoundTrips) {
   const auto& m = static_cast<const People2D&>(*back.message);
   EXPECT_EQ(m.header, original->header);
   EXPECT_EQ(m.layout, LayoutId::body25);
+  EXPECT_EQ(m.camera, "left cam");
   ASSERT_EQ(m.people.size(), 3u);
   EXPECT_EQ(m.people[0].id, -1);
   EXPECT_EQ(m.people[2].box.x, 2.0f);
@@ -111,14 +114,21 @@ TEST(WireFormat, People3DRoundTrips) {
   EXPECT_EQ(p.keypoints[3].confidence, 0.75f);
   EXPECT_EQ(m.people[1].provenance.clip, "");
   EXPECT_FALSE(m.people[1].placed);
+  EXPECT_EQ(m.frame, CoordinateFrame::of_camera("cam_02"));
   EXPECT_TRUE(m.has_ground);
-  EXPECT_EQ(m.ground.normal, glm::vec3(0.0f, -0.96f, 0.28f));
-  EXPECT_EQ(m.ground.offset, 1.6f);
+  EXPECT_EQ(m.ground.normal, glm::dvec3(glm::vec3(0.0f, -0.96f, 0.28f)));  // binary32 on the wire
+  EXPECT_EQ(m.ground.offset, static_cast<double>(1.6f));
+  // The rig's world: no camera name.
+  original->frame = CoordinateFrame::world();
+  const Packet world = round_trip(Packet::of<People3D>(original));
+  EXPECT_TRUE(static_cast<const People3D&>(*world.message).frame.is_world());
+  EXPECT_EQ(static_cast<const People3D&>(*world.message).frame.camera, "");
 }
 
 TEST(WireFormat, PoseMatchesRoundTrips) {
   auto original = std::make_shared<PoseMatches>();
   original->header.stream = "cam0";
+  original->camera = "side";
   for (int p = 0; p < 3; ++p) {
     PersonMatch person;
     person.id = 10 + p;
@@ -131,6 +141,7 @@ TEST(WireFormat, PoseMatchesRoundTrips) {
   }
   const Packet back = round_trip(Packet::of<PoseMatches>(original));
   const auto& m = static_cast<const PoseMatches&>(*back.message);
+  EXPECT_EQ(m.camera, "side");
   ASSERT_EQ(m.people.size(), 3u);
   EXPECT_EQ(m.people[2].id, 12);
   EXPECT_FALSE(m.people[1].normalized_ok);
@@ -152,7 +163,7 @@ TEST(WireFormat, VideoFrameTravelsWithoutCopies) {
   const Packet back = wire::decode(received).packet;
   const auto& m = static_cast<const VideoFrame&>(*back.message);
   EXPECT_EQ(m.image.data(), received[2].data);  // the decoder wraps the received frame
-  EXPECT_EQ(m.camera_id, 2);
+  EXPECT_EQ(m.camera, "cam_03");
   EXPECT_EQ(m.image.width(), 64);
   EXPECT_EQ(m.image.format(), PixelFormat::bgr8);
   EXPECT_EQ(std::memcmp(m.image.data(), original->image.data(), original->image.size_bytes()), 0);
@@ -204,10 +215,13 @@ std::vector<Frame> patched(std::vector<Frame> frames, std::size_t frame, std::si
 TEST(WireFormat, MalformedMessagesAreRejectedWithAReason) {
   const auto valid = as_received(wire::encode(Packet::of<People2D>(people_2d()), 0));
   EXPECT_NE(rejection({}).find("empty"), std::string::npos);
-  for (const std::uint16_t version : {1, 3}) {  // 1: People3D had no placement frame
-    EXPECT_NE(rejection(patched(valid, 0, 4, &version, 2))
-                  .find("version " + std::to_string(version) + " is not supported"),
-              std::string::npos);
+  // 1: People3D had no placement frame; 2: messages did not say their camera.
+  for (const std::uint16_t version : {1, 2, 4}) {
+    const std::string reason = rejection(patched(valid, 0, 4, &version, 2));
+    EXPECT_NE(reason.find("version " + std::to_string(version) + " is not supported"),
+              std::string::npos)
+        << reason;
+    EXPECT_EQ(reason.find("update it") != std::string::npos, version < wire::kVersion) << reason;
   }
   EXPECT_NE(rejection(patched(valid, 0, 0, "XXXX", 4)).find("bad magic"), std::string::npos);
   const std::uint16_t type = 77;
@@ -237,11 +251,33 @@ TEST(WireFormat, MalformedMessagesAreRejectedWithAReason) {
   // Lying image geometry.
   const auto frame = as_received(wire::encode(Packet::of<VideoFrame>(video_frame()), 0));
   const std::uint32_t huge = 1'000'000;
-  EXPECT_NE(rejection(patched(frame, 1, 4, &huge, 4)).find("VideoFrame"), std::string::npos);
+  EXPECT_NE(rejection(patched(frame, 1, 0, &huge, 4)).find("VideoFrame"), std::string::npos);
   const std::uint32_t narrow_stride = 10;
-  EXPECT_NE(rejection(patched(frame, 1, 12, &narrow_stride, 4)).find("stride"), std::string::npos);
+  EXPECT_NE(rejection(patched(frame, 1, 8, &narrow_stride, 4)).find("stride"), std::string::npos);
   const std::uint8_t format = 9;
-  EXPECT_NE(rejection(patched(frame, 1, 16, &format, 1)).find("pixel format"), std::string::npos);
+  EXPECT_NE(rejection(patched(frame, 1, 12, &format, 1)).find("pixel format"), std::string::npos);
+  // Camera names: a length the frame cannot hold, a control character.
+  const std::uint16_t long_name = 300;
+  EXPECT_NE(rejection(patched(frame, 1, 14, &long_name, 2)).find("camera name longer"),
+            std::string::npos);
+  EXPECT_NE(rejection(patched(frame, 1, 16, "\n", 1)).find("control character"), std::string::npos);
+  const auto people3d = as_received(wire::encode(Packet::of<People3D>(people_3d()), 0));
+  const std::uint8_t kind = 7;
+  EXPECT_NE(rejection(patched(people3d, 1, 4, &kind, 1)).find("unknown frame kind"),
+            std::string::npos);
+}
+
+TEST(WireFormat, CameraNamesThatCannotTravelAreRefused) {
+  auto m = people_2d();
+  m->camera = "";
+  EXPECT_THROW(wire::encode(Packet::of<People2D>(m), 0), WireError);
+  m->camera = std::string(wire::kMaxCameraNameBytes + 1, 'c');
+  EXPECT_THROW(wire::encode(Packet::of<People2D>(m), 0), WireError);
+  m->camera = std::string(wire::kMaxCameraNameBytes, 'c');
+  EXPECT_NO_THROW(wire::encode(Packet::of<People2D>(m), 0));
+  auto p = people_3d();
+  p->frame = {CoordinateFrame::Kind::world, "cam_01"};
+  EXPECT_THROW(wire::encode(Packet::of<People3D>(p), 0), WireError);
 }
 
 TEST(WireFormat, RandomBytesNeverCrashTheDecoder) {

@@ -170,8 +170,8 @@ TEST_F(HumanEvaShared, CamerasProjectThe3dTruthOntoThe2dTruth) {
   ASSERT_EQ(cameras.size(), 3u);
   for (const char* subject : {"S1", "S2", "S3"}) {
     for (int k = 0; k < kCameras; ++k) {
-      const Camera& cam = cameras.at(subject)[k];
-      EXPECT_EQ(cam.id, kCameraNames[k]);
+      const camera::Camera& cam = cameras.at(subject).cameras.at(k);
+      EXPECT_EQ(cam.name, kCameraNames[k]);
       std::vector<double> residuals;
       for (const Chunk* c : data().select(std::nullopt, subject)) {
         for (std::size_t t = 0; t < c->frames(); t += 5) {
@@ -184,8 +184,8 @@ TEST_F(HumanEvaShared, CamerasProjectThe3dTruthOntoThe2dTruth) {
         }
       }
       std::sort(residuals.begin(), residuals.end());
-      EXPECT_LT(residuals[residuals.size() / 2], 2.0) << subject << " " << cam.id;
-      EXPECT_LT(residuals.back(), 30.0) << subject << " " << cam.id;
+      EXPECT_LT(residuals[residuals.size() / 2], 2.0) << subject << " " << cam.name;
+      EXPECT_LT(residuals.back(), 30.0) << subject << " " << cam.name;
     }
   }
 }

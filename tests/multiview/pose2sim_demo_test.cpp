@@ -16,8 +16,7 @@
 #include <gtest/gtest.h>
 #include <glm/geometric.hpp>
 
-#include "camera/pose2sim_calibration.hpp"
-#include "camera/undistortion.hpp"
+#include "camera/rig_file.hpp"
 #include "eval/pose2sim_trial.hpp"
 #include "io/openpose_json.hpp"
 #include "io/trc.hpp"
@@ -41,26 +40,27 @@ int body25b_keypoint(const std::string& marker) {
   return -1;
 }
 
-glm::dmat3 intrinsic_matrix(const camera::CameraIntrinsics& c) {
-  glm::dmat3 k(1.0);  // GLM is column-major, CameraIntrinsics::K row-major
+glm::dmat3 intrinsic_matrix(const camera::Camera& c) {
+  const std::array<double, 9> rows = c.matrix();
+  glm::dmat3 k(1.0);  // GLM is column-major, Camera::matrix() row-major
   for (int r = 0; r < 3; ++r) {
-    for (int col = 0; col < 3; ++col) k[col][r] = c.K[3 * r + col];
+    for (int col = 0; col < 3; ++col) k[col][r] = rows[static_cast<std::size_t>(3 * r + col)];
   }
   return k;
 }
 
 struct Demo {
-  std::vector<camera::Pose2SimCamera> cameras;
+  std::vector<camera::Camera> cameras;
   std::vector<multiview::ViewGeometry> views;
   std::vector<io::OpenPoseSequence> json;  // per camera, in name order
   io::TrcFile trc;
 
   Demo() {
     const auto root = shared_data();
-    cameras = camera::read_pose2sim_calibration(root / kCalibration);
+    cameras = camera::read_rig(root / kCalibration).cameras;
     for (const auto& c : cameras) {
-      views.push_back(multiview::ViewGeometry::from_krt(intrinsic_matrix(c.intrinsics),
-                                                        c.rotation_matrix(), c.translation));
+      views.push_back(
+          multiview::ViewGeometry::from_krt(intrinsic_matrix(c), c.rotation, c.translation));
     }
     io::OpenPoseOptions options;
     options.body25 = io::Body25Choice::body25b;
@@ -82,7 +82,7 @@ struct Demo {
         const std::span<float> xyc = out.add_person(static_cast<int>(c));
         std::vector<std::array<float, 2>> pixels;
         for (const Keypoint2D& k : person.joints) pixels.push_back({k.x, k.y});
-        camera::undistort_pixels(cameras[c].intrinsics, pixels);
+        cameras[c].undistort_pixels(pixels);
         for (std::size_t k = 0; k < person.joints.size() && k < 25; ++k) {
           xyc[3 * k] = pixels[k][0];
           xyc[3 * k + 1] = pixels[k][1];

@@ -4,8 +4,10 @@
 #include <random>
 
 #include <gtest/gtest.h>
+#include <glm/trigonometric.hpp>
 
 #include "posedb/normalization.hpp"
+#include "posedb/view_set.hpp"
 
 namespace mocap::posedb {
 namespace {
@@ -30,8 +32,9 @@ TEST(ViewSet, DefaultIsThirtyYawsAtFourHeights) {
 // Hand-computed: a level camera 4 m in front (yaw 0) at root height.
 TEST(Projection, LevelFrontCamera) {
   const View v{0.0f, 0.95f, 4.0f, 0.0f};
-  const CameraPose cam = camera_pose(v, 0.95f);
-  EXPECT_NEAR(cam.position.z, 4.0f, 1e-6);
+  const camera::Camera cam = view_camera(v, 0.95f);
+  EXPECT_NEAR(cam.centre().z, 4.0, 1e-6);
+  EXPECT_NEAR(cam.optical_axis().z, -1.0, 1e-6);  // looking at the root
   std::array<glm::vec2, kBodyJoints> out;
   // A point 1 m up and 0.5 m to the person's left (+X): image right, up (y negative), at depth 4.
   project_body(one_point_body({0.5f, 1.0f, 0.0f}), cam, out);
@@ -46,7 +49,7 @@ TEST(Projection, LevelFrontCamera) {
 TEST(Projection, SideCameraSeesDepthAsX) {
   // Yaw 90: the camera stands at the person's left (+X) looking towards -X. The person's front
   // (+Z) then appears on the image left.
-  const CameraPose cam = camera_pose({90.0f, 0.95f, 4.0f, 0.0f}, 0.95f);
+  const camera::Camera cam = view_camera({90.0f, 0.95f, 4.0f, 0.0f}, 0.95f);
   std::array<glm::vec2, kBodyJoints> out;
   project_body(one_point_body({0.0f, 0.0f, 1.0f}), cam, out);
   EXPECT_NEAR(out[0].x, -0.25f, 1e-6);
@@ -54,7 +57,7 @@ TEST(Projection, SideCameraSeesDepthAsX) {
 }
 
 TEST(Projection, PitchedCameraLooksAtTheRoot) {
-  const CameraPose cam = camera_pose({0.0f, 4.95f, 4.0f, 45.0f}, 0.95f);
+  const camera::Camera cam = view_camera({0.0f, 4.95f, 4.0f, 45.0f}, 0.95f);
   std::array<glm::vec2, kBodyJoints> out;
   project_body(one_point_body({0.0f, 0.0f, 0.0f}), cam, out);
   EXPECT_NEAR(out[0].x, 0.0f, 1e-6);

@@ -38,7 +38,7 @@ TEST(PersonRescoring, ThePersonsOwnPoseComesFirstOnTheirProportions) {
     for (int b = 0; b < kBodyJoints; ++b) body[b] = {j[3 * b], j[3 * b + 1], j[3 * b + 2]};
     std::array<glm::vec2, kBodyJoints> image;
     posedb::project_body(motion::retarget(body, person),
-                         posedb::camera_pose(db.views()[view], db.build_info().views.root_height_m),
+                         posedb::view_camera(db.views()[view], db.build_info().views.root_height_m),
                          image);
     posedb::PoseVector query;
     ASSERT_TRUE(posedb::normalize_pose(image, db.build_info().scaling, query));

@@ -44,8 +44,8 @@ class SelectionTest : public ::testing::Test {
   static std::vector<BodyXyc> replay(std::uint32_t clip, std::uint32_t first, std::uint32_t count,
                                      std::uint32_t view) {
     const auto& info = db_->clips()[clip];
-    const posedb::CameraPose camera =
-        posedb::camera_pose(db_->views()[view], db_->build_info().views.root_height_m);
+    const camera::Camera camera =
+        posedb::view_camera(db_->views()[view], db_->build_info().views.root_height_m);
     std::vector<BodyXyc> frames;
     for (std::uint32_t f = info.first_frame + first; f < info.first_frame + first + count; ++f) {
       std::array<glm::vec3, kBodyJoints> body;

@@ -1,6 +1,7 @@
 #include "recon/view_refinement.hpp"
 
 #include <gtest/gtest.h>
+#include <glm/trigonometric.hpp>
 
 #include "posedb/projection.hpp"
 
@@ -31,7 +32,7 @@ std::array<glm::vec3, kBodyJoints> body() {
 TEST(ViewRefinement, RecoversAnOffGridView) {
   const posedb::View truth{31.0f, 2.1f, 4.0f, glm::degrees(std::atan2(2.1f - 0.95f, 4.0f))};
   std::array<glm::vec2, kBodyJoints> image;
-  posedb::project_body(body(), posedb::camera_pose(truth, 0.95f), image);
+  posedb::project_body(body(), posedb::view_camera(truth, 0.95f), image);
   posedb::PoseVector query;
   ASSERT_TRUE(posedb::normalize_pose(image, posedb::Scaling::bbox_height, query));
   const posedb::View grid{36.0f, 2.5f, 4.0f,
@@ -46,7 +47,7 @@ TEST(ViewRefinement, RecoversAnOffGridView) {
 TEST(ViewRefinement, MissingJointsAreLeftOutAndAPerfectMatchStays) {
   const posedb::View view{48.0f, 1.5f, 4.0f, glm::degrees(std::atan2(1.5f - 0.95f, 4.0f))};
   std::array<glm::vec2, kBodyJoints> image;
-  posedb::project_body(body(), posedb::camera_pose(view, 0.95f), image);
+  posedb::project_body(body(), posedb::view_camera(view, 0.95f), image);
   posedb::PoseVector query;
   ASSERT_TRUE(posedb::normalize_pose(image, posedb::Scaling::bbox_height, query));
   query[2 * index(Joint::left_wrist)] = query[2 * index(Joint::left_wrist) + 1] = NAN;

@@ -119,7 +119,7 @@ std::vector<std::vector<std::string>> garbage() {
   bad.push_back({valid[0].substr(0, 20)});                                       // truncated header
   bad.push_back({valid[0], valid[1], valid[2].substr(0, valid[2].size() - 5)});  // short keypoints
   auto version = valid;
-  version[0][4] = 3;  // wire format version 3
+  version[0][4] = 2;  // wire format version 2: before messages named their camera
   bad.push_back(version);
   auto oversized = valid;
   const std::uint32_t people = 5000;  // beyond the 4096 limit
@@ -181,8 +181,9 @@ TEST_F(RemoteKeypointsTest, KeypointsFromPythonArriveAsSentAndGarbageIsCounted) 
   EXPECT_TRUE(run.wait_for_log("rejected message 1: .* from 127\\.0\\.0\\.1 on " + in, 1s))
       << run.err();
 
-  Python client(dir_, {"tools/remote/send_keypoints.py", kFolder, "--endpoint", in, "--layout",
-                       "BODY_25", "--limit", std::to_string(kFrames), "--stream", "py"});
+  Python client(dir_,
+                {"tools/remote/send_keypoints.py", kFolder, "--endpoint", in, "--layout", "BODY_25",
+                 "--limit", std::to_string(kFrames), "--stream", "py", "--camera", "side_left"});
   ASSERT_EQ(client.wait(60s), 0) << client.err();
 
   io::OpenPoseOptions options;
@@ -201,6 +202,7 @@ TEST_F(RemoteKeypointsTest, KeypointsFromPythonArriveAsSentAndGarbageIsCounted) 
     ASSERT_LT(i, static_cast<std::size_t>(kFrames));
     const People2D& want = expected.frames[i];
     EXPECT_EQ(m.header.stream, "py");
+    EXPECT_EQ(m.camera, "side_left");  // wire format 3: the sender names its camera
     EXPECT_EQ(m.header.seq, i);
     EXPECT_EQ(m.header.frame, want.header.frame);
     EXPECT_GT(m.header.capture_ns, 0);

@@ -55,9 +55,9 @@ TEST(CalibrateCharuco, SyntheticViewsThroughTheBinary) {
       << run.out();
   EXPECT_NE(run.out().find("used 6 views"), std::string::npos) << run.out();
   EXPECT_NE(run.out().find("RMS reprojection error 0."), std::string::npos) << run.out();
-  const camera::CameraIntrinsics c = camera::read_camera_file(dir.file("cam.yml"));
-  EXPECT_NEAR(c.fx(), 700.0, 0.03 * 700.0);
-  EXPECT_NEAR(c.fy(), 700.0, 0.03 * 700.0);
+  const camera::Camera c = camera::read_camera_file(dir.file("cam.yml"));
+  EXPECT_NEAR(c.fx, 700.0, 0.03 * 700.0);
+  EXPECT_NEAR(c.fy, 700.0, 0.03 * 700.0);
 
   std::vector<std::string> bad = base;
   bad.back() = "DICT_3X3_9";

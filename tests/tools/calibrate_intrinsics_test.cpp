@@ -38,9 +38,9 @@ TEST(CalibrateIntrinsics, WritesACameraFileAndPrintsTheError) {
   EXPECT_NE(run.out().find("used 13 views"), std::string::npos) << run.out();
   EXPECT_NE(run.out().find("skipped 0 views"), std::string::npos) << run.out();
   EXPECT_NE(run.out().find("RMS reprojection error 0."), std::string::npos) << run.out();
-  const camera::CameraIntrinsics c = camera::read_camera_file(dir.file("cams/left.yml"));
+  const camera::Camera c = camera::read_camera_file(dir.file("cams/left.yml"));
   EXPECT_EQ(c.width, 640);
-  EXPECT_NEAR(c.fx(), 536.0, 30.0);
+  EXPECT_NEAR(c.fx, 536.0, 30.0);
 
   test::Mocap bad_board(dir, "bad", {"calibrate", "intrinsics", args[2], "--board", "9by6"});
   EXPECT_EQ(bad_board.wait(60s), 1);

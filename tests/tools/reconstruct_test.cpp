@@ -154,9 +154,8 @@ TEST_F(ReconstructTest, ACameraFileReplacesImageSizeAndFieldOfView) {
     const auto code = r.wait(120s);  // before reading stderr: argument order is unspecified
     return std::make_pair(code, r.err());
   };
-  camera::CameraIntrinsics same = camera::from_fov(1920, 1080, 50.0);
-  same.K[2] = 960.0;  // --image-size puts the principal point at w/2, h/2 (OpenCV: (w-1)/2)
-  same.K[5] = 540.0;
+  // What --image-size assumes: the principal point at w/2, h/2.
+  const camera::Camera same = camera::Camera::from_fov(1920, 1080, 50.0);
   camera::write_camera_file(dir_->file("cam.yml"), same);
   const auto [fov_code, fov_err] = run("fov", {"--image-size", "1920x1080", "--hfov", "50"});
   ASSERT_EQ(fov_code, 0) << fov_err;

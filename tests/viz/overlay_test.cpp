@@ -338,13 +338,13 @@ TEST(ScenePanel, FloorIsTheKnownOneElseUnderThePlacedFeetElseAssumed) {
   People3D people3d;
   people3d.people = {camera.person(1, 0.0f, 5.0f)};
   const GroundPlane under_feet = scene_floor(people3d);  // level in the image, through the ankles
-  EXPECT_EQ(under_feet.normal, glm::vec3(0, -1, 0));
+  EXPECT_EQ(under_feet.normal, glm::dvec3(0, -1, 0));
   const glm::vec3 ankle =
       people3d.people[0].root.translation + people3d.people[0].positions[index(Joint::left_ankle)];
   EXPECT_NEAR(under_feet.offset, ankle.y, 1e-5f);
   people3d.has_ground = true;
   people3d.ground = camera.ground();
-  EXPECT_EQ(scene_floor(people3d).normal, camera.up());
+  EXPECT_EQ(scene_floor(people3d).normal, glm::dvec3(camera.up()));
   people3d = {};
   EXPECT_EQ(scene_floor(people3d).offset, assumed_ground().offset);
 }

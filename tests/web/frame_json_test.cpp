@@ -32,7 +32,7 @@ TEST(FrameJson, PlacedPeopleKeepTheirPositionUnplacedStandOnTheFloorInARow) {
   People3D frame = test::walking_people(3, 7);
   frame.people[0].placed = true;
   frame.people[0].root.translation = {0.5f, 0.2f, 4.0f};
-  const Json json = Json::parse(frame_json(frame, CameraView{}));
+  const Json json = Json::parse(frame_json(frame, std::nullopt));
   ASSERT_EQ(json["type"], "frame");
   EXPECT_EQ(json["frame"], 7);
   ASSERT_EQ(json["people"].size(), 3u);
@@ -63,11 +63,11 @@ TEST(FrameJson, PlacedPeopleKeepTheirPositionUnplacedStandOnTheFloorInARow) {
 TEST(FrameJson, UnplacedPeopleStandOnAKnownTiltedFloor) {
   People3D frame = test::walking_people(1, 0);
   frame.has_ground = true;
-  frame.ground.normal = glm::normalize(glm::vec3(0.0f, -0.9f, 0.3f));
-  frame.ground.offset = 2.0f;
-  const Json json = Json::parse(frame_json(frame, CameraView{}));
+  frame.ground.normal = glm::normalize(glm::dvec3(0.0, -0.9, 0.3));
+  frame.ground.offset = 2.0;
+  const Json json = Json::parse(frame_json(frame, std::nullopt));
   const glm::vec3 root = joint_mm(json["people"][0], Joint::root) / 1000.0f;
-  EXPECT_NEAR(glm::dot(frame.ground.normal, root) + frame.ground.offset, 0.95f, 0.003f);
+  EXPECT_NEAR(frame.ground.height_of(glm::dvec3(root)), 0.95, 0.003);
   EXPECT_TRUE(json["ground"]["known"].get<bool>());
   EXPECT_NEAR(json["ground"]["offset"].get<double>(), 2.0, 1e-6);
 }
@@ -77,7 +77,15 @@ TEST(FrameJson, MissingValuesAreNullOrZeroTheCameraAndPlaybackAreSent) {
   frame.people[0].positions[index(Joint::left_wrist)].x = std::numeric_limits<float>::quiet_NaN();
   frame.people[0].keypoints[index(Joint::head)] = {std::nanf(""), 3.0f, 0.8f};
   frame.people[0].keypoints[index(Joint::neck)].confidence = 0.0f;
-  const CameraView camera{true, false, 640, 480, 500.0f, 510.0f, 320.5f, 240.25f};
+  camera::Camera lens;
+  lens.name = "cam_01";
+  lens.width = 640;
+  lens.height = 480;
+  lens.fx = 500.0;
+  lens.fy = 510.0;
+  lens.cx = 320.5;
+  lens.cy = 240.25;
+  const ShownCamera camera{lens, false};
   const Json json = Json::parse(frame_json(frame, camera, Playback{3, 10, false, 2.0, 1.5}, 0.25));
   const Json& person = json["people"][0];
   EXPECT_TRUE(person["joints"][3 * index(Joint::left_wrist)].is_null());

@@ -244,8 +244,9 @@ int main(int argc, char** argv) {
     const auto cameras = eval::default_cameras(!args.has("all-cameras"));
     const auto conditions = eval::default_conditions(!args.has("all-conditions"));
     const eval::Image image;
-    const recon::Pinhole pinhole =
-        recon::Pinhole::from_fov(image.width, image.height, image.horizontal_fov_deg);
+    const camera::Camera lens =
+        camera::Camera::from_fov(image.width, image.height, image.horizontal_fov_deg);
+    const recon::Pinhole pinhole = recon::pinhole_of(lens);  // what components/fit takes
 
     recon::Matcher matcher(db, {});
     const recon::FrameBones bones(db);
@@ -254,7 +255,7 @@ int main(int argc, char** argv) {
     retrieval.fps = fps;
     retrieval.selection = recon::Selection::path;
     retrieval.smoothing = recon::Smoothing::savitzky_golay;
-    retrieval.camera = pinhole;
+    retrieval.camera = lens;
     retrieval.refine_view = true;
 
     fit::FitOptions options;

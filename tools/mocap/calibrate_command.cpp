@@ -24,6 +24,8 @@
 #include "camera/charuco_calibration.hpp"
 #include "camera/chessboard_calibration.hpp"
 #include "camera/ground_from_board.hpp"
+#include "camera/rig.hpp"
+#include "camera/rig_file.hpp"
 #include "cli_args.hpp"
 #include "commands.hpp"
 #include "core/input_error.hpp"
@@ -230,7 +232,7 @@ int layout_command(int argc, char** argv) {
                                eval::evaluate_offsets_3d(other.offsets, trials[a].frames));
     }
     const fs::path toml = fs::path(args.get("pose2sim")) / "calibration" / "Calib_qualisys.toml";
-    const auto cameras = camera::read_pose2sim_calibration(toml);
+    const auto cameras = camera::read_rig(toml).cameras;
     std::cout << "\n"
               << check_table("## " + std::string(lay->name) +
                                  ": 2D check, keypoints and reference projected through the " +
@@ -390,10 +392,10 @@ int intrinsics_command(int argc, char** argv) {
   for (const auto& name : result.used) std::cout << "  " << name << "\n";
   std::cout << "skipped " << result.skipped.size() << " views:\n";
   for (const auto& s : result.skipped) std::cout << "  " << s.name << ": " << s.reason << "\n";
-  const camera::CameraIntrinsics& c = result.camera;
+  const camera::Camera& c = result.camera;
   std::cout << "image " << c.width << "x" << c.height << "\n"
-            << "fx " << fixed(c.fx(), 2) << "  fy " << fixed(c.fy(), 2) << "  cx "
-            << fixed(c.cx(), 2) << "  cy " << fixed(c.cy(), 2) << "\ndistortion";
+            << "fx " << fixed(c.fx, 2) << "  fy " << fixed(c.fy, 2) << "  cx " << fixed(c.cx, 2)
+            << "  cy " << fixed(c.cy, 2) << "\ndistortion";
   for (double d : c.distortion) std::cout << " " << fixed(d, 5);
   std::cout << "\nRMS reprojection error " << fixed(result.rms_px, 3) << " px\n";
   if (args.has("out")) {
@@ -417,7 +419,9 @@ int ground_command(int argc, char** argv) {
       "into the camera file (ground_normal, ground_offset).\nWithout a board, `mocap "
       "reconstruct` estimates the ground from the feet of the people in view\nover time.");
   args.positional("image", "an image of the board on the floor, taken by the calibrated camera");
-  args.option("camera", "FILE", "the camera file (OpenCV YAML, from `mocap calibrate intrinsics`)");
+  args.option("camera", "FILE",
+              "the camera file (OpenCV YAML from `mocap calibrate intrinsics`, or a rig file of "
+              "one camera)");
   board_options(args);
   args.option("thickness", "MM", "thickness of the board: the floor lies this far below it", "0")
       .option("out", "FILE",
@@ -429,7 +433,7 @@ int ground_command(int argc, char** argv) {
   const double thickness = args.number("thickness");
   if (!(thickness >= 0)) throw InputError("--thickness", "must be zero or positive");
   const std::string camera_file = args.get("camera");
-  const camera::CameraIntrinsics cam = camera::read_camera_file(camera_file);
+  const camera::Camera cam = camera::read_camera_file(camera_file);
   const std::string image = args.positionals().front();
   const camera::FloorFromBoard floor =
       camera::ground_from_board_image(image, cam, board, thickness);
@@ -442,9 +446,10 @@ int ground_command(int argc, char** argv) {
             << fixed(floor.translation_m[1], 4) << " " << fixed(floor.translation_m[2], 4) << " m\n"
             << "floor normal (up, camera frame) " << fixed(n[0], 5) << " " << fixed(n[1], 5) << " "
             << fixed(n[2], 5) << "\n"
-            << "camera height above the floor " << fixed(camera::camera_height_m(floor.plane), 4)
-            << " m\n"
-            << "camera tilt " << fixed(camera::camera_tilt_deg(floor.plane), 2)
+            << "camera height above the floor "
+            << fixed(camera::height_above_m(camera::Camera{}, floor.plane), 4) << " m\n"
+            << "camera tilt "
+            << fixed(camera::tilt_below_horizon_deg(camera::Camera{}, floor.plane), 2)
             << " degrees below the horizon\n";
   std::string target = camera_file;
   if (args.has("out")) {

@@ -16,6 +16,7 @@ int crossview_eval_command(int argc, char** argv);
 int reconstruct_command(int argc, char** argv);
 int camera_command(int argc, char** argv);
 int calibrate_command(int argc, char** argv);
+int rig_command(int argc, char** argv);
 int retarget_command(int argc, char** argv);
 int keys_command(int argc, char** argv);
 int view_command(int argc, char** argv);

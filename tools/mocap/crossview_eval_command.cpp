@@ -31,6 +31,7 @@
 #include "fit/fit_evaluation.hpp"
 #include "fit/foot_contact.hpp"
 #include "fit/view_fit.hpp"
+#include "fit_cameras.hpp"
 #include "output_files.hpp"
 #include "posedb/parallel_chunks.hpp"
 #include "progress_bar.hpp"
@@ -48,8 +49,7 @@ struct ViewJob {
   std::string name;       // camera name
   std::vector<recon::BodyXyc> input;
   std::vector<eval::Body> truth_camera;  // absolute, camera frame
-  recon::Pinhole intrinsics;
-  fit::CameraPose camera;  // camera -> world
+  camera::Camera camera;                 // intrinsics and pose in the world
   bool layout_offsets = false;
 };
 
@@ -63,23 +63,13 @@ constexpr std::array<const char*, 3> kMethods = {"truth", "retrieval only", "+ f
 constexpr glm::dvec3 kUp{0.0, 0.0, 1.0};  // both worlds are Z up
 
 // The horizontal angle between two cameras' optical axes, degrees.
-double angle_between(const fit::CameraPose& a, const fit::CameraPose& b) {
-  auto axis = [](const fit::CameraPose& c) {
-    glm::dvec3 z = glm::mat3_cast(c.rotation) * glm::dvec3(0, 0, 1);
+double angle_between(const camera::Camera& a, const camera::Camera& b) {
+  auto axis = [](const camera::Camera& c) {
+    glm::dvec3 z = c.optical_axis();
     z -= glm::dot(z, kUp) * kUp;
     return glm::normalize(z);
   };
   return std::acos(std::clamp(glm::dot(axis(a), axis(b)), -1.0, 1.0)) * 180.0 / std::numbers::pi;
-}
-
-fit::CameraPose pose_of(const camera::Pose2SimCamera& c) {
-  const glm::dmat3 to_world = glm::transpose(c.rotation_matrix());
-  return {glm::quat_cast(to_world), c.centre()};
-}
-
-recon::Pinhole pinhole_of(const camera::CameraIntrinsics& k) {
-  return {static_cast<float>(k.fx()), static_cast<float>(k.fy()), static_cast<float>(k.cx()),
-          static_cast<float>(k.cy())};
 }
 
 double percentile(std::vector<double> v, double p) {
@@ -122,8 +112,7 @@ json add_pose2sim(const std::string& trial_dir, const std::string& calibration, 
     job.name = v.camera.name;
     job.input = eval::resample_keypoints(v.input, trial.fps, fps);
     job.truth_camera = eval::resample_bodies(v.truth_camera, trial.fps, fps);
-    job.intrinsics = pinhole_of(v.camera.intrinsics);
-    job.camera = pose_of(v.camera);
+    job.camera = v.camera;
     job.layout_offsets = offsets;
     group.views.push_back(jobs.size());
     jobs.push_back(std::move(job));
@@ -146,18 +135,16 @@ void add_humaneva(const std::string& folder, double fps, std::size_t max_frames,
     if (groups.empty() || groups.back().dataset != "HumanEva-I" ||
         groups.back().name != s.subject + " " + s.chunk)
       groups.push_back({"HumanEva-I", s.subject + " " + s.chunk, {}});
-    const he::Camera& camera = cameras.at(s.subject)[s.camera.back() - '1'];
     ViewJob job;
     job.group = groups.size() - 1;
-    job.name = s.camera;
+    job.name = s.camera.name;
     job.input = s.input;
     job.truth_camera = s.truth_camera;
     if (max_frames > 0 && job.input.size() > max_frames) {
       job.input.resize(max_frames);
       job.truth_camera.resize(max_frames);
     }
-    job.intrinsics = s.intrinsics;
-    job.camera = {camera.orientation, camera.centre};
+    job.camera = s.camera;
     groups.back().views.push_back(jobs.size());
     jobs.push_back(std::move(job));
   }
@@ -166,7 +153,7 @@ void add_humaneva(const std::string& folder, double fps, std::size_t max_frames,
 // A view's world-frame, root-relative poses for one method.
 std::vector<std::optional<eval::Body>> world_poses(const ViewJob& job, const fit::ViewFits& fits,
                                                    std::size_t method) {
-  const glm::dmat3 to_world = glm::mat3_cast(job.camera.rotation);
+  const glm::dmat3 to_world = glm::transpose(job.camera.rotation);
   std::vector<std::optional<eval::Body>> out(job.input.size());
   for (std::size_t t = 0; t < out.size(); ++t) {
     if (method == 0 && t < job.truth_camera.size())
@@ -256,12 +243,13 @@ int crossview_eval_command(int argc, char** argv) {
         retrieval.fps = fps;
         retrieval.selection = recon::Selection::path;
         retrieval.smoothing = recon::Smoothing::savitzky_golay;
-        retrieval.camera = job.intrinsics;
+        retrieval.camera = job.camera;
         retrieval.refine_view = true;
         fit::FitOptions options = fit_options;
-        options.camera = job.intrinsics;
-        fits[i] = fit::reconstruct_and_fit(matcher, bones, &contacts, job.input, job.camera,
-                                           retrieval, options, {true, false});
+        options.camera = recon::pinhole_of(job.camera);
+        fits[i] = fit::reconstruct_and_fit(matcher, bones, &contacts, job.input,
+                                           fit_camera_pose(job.camera), retrieval, options,
+                                           {true, false});
       },
       [&](std::size_t done) {
         bar.update("reconstruct", static_cast<double>(done) / static_cast<double>(jobs.size()));

@@ -72,7 +72,7 @@ std::vector<eval::Scores> run_jobs(const std::vector<Config>& configs,
       if (configs[j.config].align_to_ray) {
         const eval::Image image;
         options.camera =
-            recon::Pinhole::from_fov(image.width, image.height, image.horizontal_fov_deg);
+            camera::Camera::from_fov(image.width, image.height, image.horizontal_fov_deg);
       }
       const auto poses = recon::reconstruct_sequence(*matchers[j.config], *bones[j.config],
                                                      rendered.input, options);

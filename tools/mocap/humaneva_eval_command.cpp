@@ -185,7 +185,7 @@ std::vector<std::vector<Row>> run_jobs(const std::vector<std::vector<Variant>>& 
         if (variant.person) matcher.set_person(variant.person->at(sequences[job.sequence].subject));
         const std::uint64_t seed = 1000003ull * job.sequence + job.condition;  // same for all
         recon::SequenceOptions options = config.sequence;
-        if (config.align_to_ray) options.camera = sequences[job.sequence].intrinsics;
+        if (config.align_to_ray) options.camera = sequences[job.sequence].camera;
         if (variant.on == OffsetsOn::input) options.layout_offsets = *variant.offsets;
         if (variant.on == OffsetsOn::candidates) matcher.set_layout(*variant.offsets);
         results[i] = eval::evaluate_sequence(matcher, *bones.at(config.db), sequences[job.sequence],

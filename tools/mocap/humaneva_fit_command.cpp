@@ -25,6 +25,7 @@
 #include "fit/fit_evaluation.hpp"
 #include "fit/foot_contact.hpp"
 #include "fit/view_fit.hpp"
+#include "fit_cameras.hpp"
 #include "output_files.hpp"
 #include "posedb/parallel_chunks.hpp"
 #include "progress_bar.hpp"
@@ -131,8 +132,12 @@ int humaneva_fit_command(int argc, char** argv) {
   fit::FitOptions fit_options;
   fit_options.lag = static_cast<int>(args.integer("lag"));
   fit_options.ankle_clearance_m = args.number("clearance");
-  // HumanEva's world is Z up with the floor at Z = 0; the camera poses carry it into each view.
-  if (!args.has("no-ground")) fit_options.ground = fit::GroundPlane{{0.0, 0.0, 1.0}, 0.0};
+  // HumanEva's world is Z up with the floor at Z = 0 (the rigs' floor); the camera poses carry it
+  // into each view.
+  if (!args.has("no-ground")) {
+    const GroundPlane& floor = cameras.begin()->second.floor.value();
+    fit_options.ground = fit::GroundPlane{floor.normal, floor.offset};
+  }
 
   std::vector<std::array<Result, 3>> results(sequences.size());
   ProgressBar bar;
@@ -145,12 +150,11 @@ int humaneva_fit_command(int argc, char** argv) {
         retrieval.fps = fps;
         retrieval.selection = recon::Selection::path;
         retrieval.smoothing = recon::Smoothing::savitzky_golay;
-        retrieval.camera = s.intrinsics;
+        retrieval.camera = s.camera;
         retrieval.refine_view = true;
         fit::FitOptions options = fit_options;
-        options.camera = s.intrinsics;
-        const auto& camera = cameras.at(s.subject)[s.camera.back() - '1'];
-        const fit::CameraPose pose{camera.orientation, camera.centre};
+        options.camera = recon::pinhole_of(s.camera);
+        const fit::CameraPose pose = fit_camera_pose(s.camera);
         std::vector<recon::BodyXyc> input = s.input;
         eval::InputNoise noise(1000003ull * i);
         for (auto& frame : input) noise.apply(condition, frame);

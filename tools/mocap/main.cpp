@@ -28,6 +28,8 @@ constexpr Command kCommands[] = {
      mocap::cli::camera_command},
     {"calibrate", "keypoint layout offsets (calibration/layouts/) and camera intrinsics",
      mocap::cli::calibrate_command},
+    {"rig", "camera rigs (TOML, OpenCV YAML): what a rig file holds, convert between formats",
+     mocap::cli::rig_command},
     {"retarget", "put a BVH motion onto another skeleton (rig given in its rest pose)",
      mocap::cli::retarget_command},
     {"keys", "CURVE key pairs for graph edges and endpoints that cross the network",

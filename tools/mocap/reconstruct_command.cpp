@@ -268,6 +268,10 @@ void configure(graph::GraphSpec& spec, const Args& args, const fs::path& out, In
   if (args.has("camera")) {
     for (const char* type : {"recon.temporal_selector", "recon.fit"})
       set_param(spec, type, "camera", args.get("camera"));
+    // The messages name their camera as the camera file does (docs/cameras.md).
+    const std::string name = camera::read_camera_file(args.get("camera")).name;
+    for (const char* type : {"source.video", "source.openpose_json"})
+      set_param(spec, type, "camera", name);
   }
   set_param(spec, "sink.jsonl", "path", (out / "poses.jsonl").string());
   set_param(spec, "sink.bvh", "dir", out.string());
@@ -485,8 +489,9 @@ int reconstruct_command(int argc, char** argv) {
       .option("hfov", "DEG", "horizontal field of view assumed with --image-size", "60",
               Range::between(1.0, 179.0))
       .option("camera", "FILE",
-              "calibrated camera (OpenCV YAML from `mocap calibrate intrinsics`): its matrix and "
-              "lens distortion replace --image-size/--hfov for the ray through each root")
+              "calibrated camera: the OpenCV YAML of `mocap calibrate intrinsics` or any rig "
+              "file of one camera (docs/cameras.md); its matrix and lens distortion replace "
+              "--image-size/--hfov for the ray through each root")
       .option("fit", "auto|off|live|full",
               "skeleton fitting (root translation, the person's bones, feet on the floor): full "
               "in windows of 64 frames per person overlapping by 16 (written as each window is "
@@ -526,7 +531,7 @@ int reconstruct_command(int argc, char** argv) {
   const VideoInfo info = kind == InputKind::video ? probe_video(args) : VideoInfo{};
   if (kind == InputKind::openpose_json) {
     if (args.has("camera")) {
-      const camera::CameraIntrinsics lens = camera::read_camera_file(args.get("camera"));
+      const camera::Camera lens = camera::read_camera_file(args.get("camera"));
       check_keypoints_inside(input, lens.width, lens.height, args.get("camera"));
     } else if (args.has("image-size")) {
       const ImageSize size = args.image_size("image-size");

@@ -26,32 +26,21 @@ namespace {
 
 using namespace std::chrono_literals;
 
-std::optional<web::CameraView> camera_of(const Args& args) {
-  std::optional<camera::CameraIntrinsics> lens;
-  bool assumed = false;
-  if (args.has("camera")) {
-    lens = camera::read_camera_file(args.get("camera"));
-  } else if (args.has("image-size")) {
-    const ImageSize size = args.image_size("image-size");
-    lens = camera::from_fov(size.width, size.height, args.number("hfov"));
-    assumed = true;
-  }
-  if (!lens) return std::nullopt;
-  return web::CameraView{true,
-                         assumed,
-                         lens->width,
-                         lens->height,
-                         static_cast<float>(lens->fx()),
-                         static_cast<float>(lens->fy()),
-                         static_cast<float>(lens->cx()),
-                         static_cast<float>(lens->cy())};
+std::optional<web::ShownCamera> camera_of(const Args& args) {
+  if (args.has("camera")) return web::ShownCamera{camera::read_camera_file(args.get("camera"))};
+  if (!args.has("image-size")) return std::nullopt;
+  const ImageSize size = args.image_size("image-size");
+  return web::ShownCamera{camera::Camera::from_fov(size.width, size.height, args.number("hfov")),
+                          true};
 }
 
 // The recording's 2D keypoints must lie in the image the camera says: a smaller image would draw
 // them, and the frustum, wrong.
-void check_keypoints_inside(const web::Recording& recording, const web::CameraView& camera,
-                            const std::string& path, const Args& args) {
-  if (!camera.known) return;
+void check_keypoints_inside(const web::Recording& recording,
+                            const std::optional<web::ShownCamera>& shown, const std::string& path,
+                            const Args& args) {
+  if (!shown) return;
+  const camera::Camera& camera = shown->camera;
   for (std::size_t f = 0; f < recording.frames.size(); ++f) {
     for (const Person3D& person : recording.frames[f].people) {
       for (const Keypoint2D& k : person.keypoints) {
@@ -75,7 +64,7 @@ int view_recording(const Args& args) {
   if (recording.cut_last_line)
     std::cerr << "mocap view: " << path
               << ": the last line is cut (the writer was killed while writing it): skipped\n";
-  const web::CameraView camera = camera_of(args).value_or(web::CameraView{});
+  const std::optional<web::ShownCamera> camera = camera_of(args);
   check_keypoints_inside(recording, camera, path, args);
 
   std::mutex mutex;
@@ -218,7 +207,7 @@ int view_command(int argc, char** argv) {
               Range::count(1, 1000))
       .option("fps", "F", "frame rate of a recording without usable times", "30",
               Range::between(0.1, 1000.0))
-      .option("camera", "FILE", "camera file (OpenCV YAML): draw its frustum")
+      .option("camera", "FILE", "camera file (a rig file of one camera): draw its frustum")
       .option("image-size", "WxH", "or the image size, with --hfov, for an assumed camera",
               std::nullopt, Range::image_size())
       .option("hfov", "DEG", "horizontal field of view with --image-size", "60",

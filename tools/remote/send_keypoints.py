@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Sends 2D keypoints to a mocap graph (node source.remote_keypoints) over ZeroMQ PUSH, encoded in
-the mocap wire format version 2 (docs/wire-format.md) with nothing but `struct` and `zmq`: a model
+the mocap wire format version 3 (docs/wire-format.md) with nothing but `struct` and `zmq`: a model
 of what a detector in Python (or on a GPU machine) does. The keypoints come from a folder of
 OpenPose *_keypoints.json files; replace read_openpose_folder() with your detector.
 
@@ -31,7 +31,7 @@ try:
 except ImportError:
     sys.exit("send_keypoints.py: python3-zmq is not installed (apt-get install python3-zmq)")
 
-MAGIC, VERSION = b"MOCP", 2
+MAGIC, VERSION = b"MOCP", 3
 HEADER = struct.Struct("<4sHHQqqqHH")  # 44 bytes, then the stream id
 END_OF_STREAM, PEOPLE_2D = 0, 2
 LAYOUTS = {"COCO-17": (0, 17), "BODY_25": (1, 25), "BODY_25B": (2, 25), "COCO-18": (3, 18),
@@ -54,12 +54,21 @@ def header(kind, seq, capture_ns, frame, stream, payload_frames):
                        len(stream_bytes), payload_frames) + stream_bytes
 
 
-def encode_people_2d(seq, capture_ns, frame, stream, layout, people):
+def camera_name(name):
+    """The camera name as the wire carries it: 1 to 256 bytes of UTF-8, no control characters."""
+    data = name.encode()
+    if not 1 <= len(data) <= 256 or any(b < 0x20 or b == 0x7f for b in data):
+        raise ValueError("camera name must be 1-256 bytes without control characters: %r" % name)
+    return struct.pack("<H", len(data)) + data
+
+
+def encode_people_2d(seq, capture_ns, frame, stream, layout, people, camera="cam_01"):
     """people: list of {"id": int, "joints": [(x, y, confidence), ...]} with the layout's joint
     count. Missing keypoints: confidence 0 (sent as NaN, NaN, 0). The box is the detected
-    keypoints' extent, computed in binary32 like the C++ reader does."""
+    keypoints' extent, computed in binary32 like the C++ reader does. camera: the name of the
+    camera the keypoints were detected in, as in the graph's rig file."""
     code, joints = LAYOUTS[layout]
-    meta = [struct.pack("<HHI", code, joints, len(people))]
+    meta = [struct.pack("<HHI", code, joints, len(people)) + camera_name(camera)]
     values = []
     for person in people:
         keypoints = person["joints"]
@@ -164,6 +173,8 @@ def main():
                         help="frame rate: capture times are start + frame / fps")
     parser.add_argument("--realtime", action="store_true", help="send at --fps, not at once")
     parser.add_argument("--stream", default="remote", help="stream id of the messages")
+    parser.add_argument("--camera", default="cam_01",
+                        help="the camera's name in the messages (as in the rig file)")
     parser.add_argument("--limit", type=int, default=0, help="send at most N frames (0: all)")
     parser.add_argument("--no-end", action="store_true", help="do not send EndOfStream")
     parser.add_argument("--linger-ms", type=int, default=10000,
@@ -182,6 +193,10 @@ def main():
         parser.error("unknown layout %s" % args.layout)
     if not os.path.isdir(args.folder):
         parser.error("%s is not a folder" % args.folder)
+    try:
+        camera_name(args.camera)
+    except ValueError as e:
+        parser.error(str(e))
 
     context = zmq.Context()
     socket = context.socket(zmq.PUSH)
@@ -218,7 +233,7 @@ def main():
             time.sleep(max(0.0, start + seq / args.fps - time.monotonic()))
         capture_ns = start_ns + round(1e9 * number / args.fps)
         socket.send_multipart(encode_people_2d(seq, capture_ns, number, args.stream, layout,
-                                               people))
+                                               people, args.camera))
         seq += 1
     if not args.no_end:
         socket.send_multipart(encode_end_of_stream(seq, args.stream))

@@ -40,6 +40,7 @@ class ScalerNode : public Node {
     const auto& in = ctx.input<People2D>("in");
     const KeypointLayout& lay = layout(in.layout);
     PoseMatches out;
+    out.camera = in.camera;
     for (const Person2D& person : in.people) {
       flat_.clear();
       for (const auto& k : person.joints) flat_.insert(flat_.end(), {k.x, k.y, k.confidence});

@@ -6,7 +6,6 @@
 
 #include <optional>
 
-#include "camera/undistortion.hpp"
 #include "graph/registry.hpp"
 #include "nodes/recon/node_camera.hpp"
 #include "posedb/database.hpp"
@@ -49,12 +48,7 @@ class TemporalSelectorNode : public Node {
     o.lag = ctx.param<int>("lag");
     o.max_missed = ctx.param<int>("max_missed");
     camera_ = read_camera_params(ctx);
-    o.camera = camera_.pinhole;  // invalid: poses stay as the database cameras see them
-    if (camera_.lens)
-      o.undistort = [this](glm::vec2 p) {
-        const auto [x, y] = camera::undistort_pixel(*camera_.lens, p.x, p.y);
-        return glm::vec2(x, y);
-      };
+    o.camera = camera_.camera;  // no intrinsics: poses stay as the database cameras see them
     selector_.emplace(*db_, *bones_, std::move(o));
   }
 

@@ -2,9 +2,11 @@
 //   {"frame": 0, "time": 0.0, "people": [{"id": 1, "joints": {"head": [x, y, z], ...},
 //    "joints_abs": {...}, "keypoints": [x, y, c, ...]}], "ground": {"normal": [x, y, z], "offset":
 //    d}}
-// with the 15 body joint names, metres, camera coordinates (x right, y down, z forward).
-// `joints` are root-relative; `joints_abs` (absolute camera-frame positions) appear for people
-// whose root translation is estimated (recon.fit), `keypoints` (the 15 body joints' 2D input, image
+// with the 15 body joint names, metres, in the message's frame: a camera's coordinates (x right,
+// y down, z forward), or the rig's world. `joints` are root-relative; `joints_abs` (absolute
+// camera-frame positions) appear for people whose root translation is estimated (recon.fit),
+// `joints_world` instead for people of a world-frame message (the rig's world, e.g. a multi-view
+// reconstruction), `keypoints` (the 15 body joints' 2D input, image
 // pixels as detected and confidence, 0 0 0 where missing) for people reconstructed from a 2D
 // detection, so that a recording can be replayed beside its input (mocap view), `ground` once the
 // floor is known (points p with normal . p + offset = 0, normal up).
@@ -48,7 +50,9 @@ class JsonLinesSink : public Node {
     nlohmann::ordered_json people = nlohmann::ordered_json::array();
     for (const Person3D& p : in.people) {
       nlohmann::ordered_json person = {{"id", p.id}, {"joints", joints_of(p, glm::vec3(0.0f))}};
-      if (p.placed) person["joints_abs"] = joints_of(p, p.root.translation);
+      if (p.placed)
+        person[in.frame.is_world() ? "joints_world" : "joints_abs"] =
+            joints_of(p, p.root.translation);
       if (has_keypoints(p)) person["keypoints"] = keypoints_of(p);
       people.push_back(std::move(person));
     }
@@ -57,7 +61,7 @@ class JsonLinesSink : public Node {
                                    {"people", people}};
     if (in.has_ground) {
       line["ground"] = {{"normal", {in.ground.normal.x, in.ground.normal.y, in.ground.normal.z}},
-                        {"offset", round_mm(in.ground.offset)}};
+                        {"offset", round_mm(static_cast<float>(in.ground.offset))}};
     }
     file_->write(line.dump());
   }

@@ -38,13 +38,17 @@ std::uint64_t digest(const Packet& packet) {
   if (packet.type == People2D::kTypeName) {
     const auto& m = static_cast<const People2D&>(*packet.message);
     d.add(m.layout);
+    d.add(m.camera.data(), m.camera.size());
     for (const Person2D& p : m.people) {
       d.add(p.id);
       d.add(p.box);
       d.add(p.joints.data(), p.joints.size() * sizeof(Keypoint2D));
     }
   } else if (packet.type == People3D::kTypeName) {
-    for (const Person3D& p : static_cast<const People3D&>(*packet.message).people) {
+    const auto& m = static_cast<const People3D&>(*packet.message);
+    d.add(m.frame.kind);
+    d.add(m.frame.camera.data(), m.frame.camera.size());
+    for (const Person3D& p : m.people) {
       d.add(p.id);
       d.add(p.positions);
       d.add(p.rotations);
@@ -54,7 +58,7 @@ std::uint64_t digest(const Packet& packet) {
   } else if (packet.type == VideoFrame::kTypeName) {
     const auto& m = static_cast<const VideoFrame&>(*packet.message);
     const ImageBuffer& image = m.image;
-    d.add(m.camera_id);
+    d.add(m.camera.data(), m.camera.size());
     d.add(image.format());
     const auto row_bytes =
         static_cast<std::size_t>(image.width() * bytes_per_pixel(image.format()));

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <iostream>
 #include <memory>
+#include <optional>
 
 #include "graph/registry.hpp"
 #include "nodes/recon/node_camera.hpp"
@@ -33,17 +34,8 @@ class WebSink : public Node {
   }
 
   void open(Context& ctx) override {
-    const NodeCamera camera = read_camera_params(ctx);
-    if (camera.pinhole.valid()) {
-      camera_.known = true;
-      camera_.assumed = camera.assumed;
-      camera_.width = camera.lens ? camera.lens->width : ctx.param<int>("image_width");
-      camera_.height = camera.lens ? camera.lens->height : ctx.param<int>("image_height");
-      camera_.fx = camera.pinhole.fx;
-      camera_.fy = camera.pinhole.fy;
-      camera_.cx = camera.pinhole.cx;
-      camera_.cy = camera.pinhole.cy;
-    }
+    if (NodeCamera camera = read_camera_params(ctx); camera.known())
+      camera_ = web::ShownCamera{std::move(camera.camera), camera.assumed};
     web::ServerOptions options;
     options.host = ctx.param<std::string>("host");
     options.port = ctx.param<int>("port");
@@ -73,7 +65,7 @@ class WebSink : public Node {
   void close(Context&) override { server_.reset(); }
 
  private:
-  web::CameraView camera_;
+  std::optional<web::ShownCamera> camera_;
   std::unique_ptr<web::WebServer> server_;
   std::chrono::steady_clock::time_point last_status_{};
 };

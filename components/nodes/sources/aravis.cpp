@@ -31,7 +31,9 @@ class AravisSource : public Node {
     c.param<std::string>("pixel_format", "", "Mono8, BayerRG8, RGB8, ... (empty: the camera's)");
     c.param<std::int64_t>("buffers", 0, "stream buffers (0: half a second of frames)", {0, 1024});
     c.param<std::int64_t>("count", 0, "frames before end of stream (0: until stopped)", {0, 1e12});
-    c.param<std::int64_t>("camera", 0, "camera id in the messages", {0, 1000});
+    c.param<std::string>("camera", std::string(kDefaultCamera),
+                         "the camera's name in the messages (as in the rig file, docs/cameras.md); "
+                         "also the stream id)");
     c.param<double>("loss_timeout_ms", 1000.0,
                     "no data for this long (at least 10 frame periods): the camera is lost and "
                     "reopened; 0: only Aravis' heartbeat (6 s on the fake GigE camera)",
@@ -41,7 +43,7 @@ class AravisSource : public Node {
   void open(Context& ctx) override {
     settings_ = settings_from(ctx);
     count_ = ctx.param<std::uint64_t>("count");
-    camera_id_ = ctx.param<int>("camera");
+    camera_name_ = ctx.param<std::string>("camera");
     camera_ = std::make_unique<aravis::Camera>(settings_);  // throws naming the camera
     report_open(ctx, "streaming from");
     ctx.report_status("streaming from '" + camera_->info().id + "'");
@@ -91,9 +93,8 @@ class AravisSource : public Node {
     VideoFrame message;
     // `frame` counts delivered frames: unlike the camera's 16-bit block id it never wraps and
     // stays monotonic across reconnections.
-    message.header = {"camera" + std::to_string(camera_id_), seq_, frame.capture_ns,
-                      static_cast<std::int64_t>(seq_)};
-    message.camera_id = camera_id_;
+    message.header = {camera_name_, seq_, frame.capture_ns, static_cast<std::int64_t>(seq_)};
+    message.camera = camera_name_;
     message.image = std::move(frame.image);
     ctx.send("frames", std::move(message));
     ++seq_;
@@ -143,7 +144,7 @@ class AravisSource : public Node {
   std::unique_ptr<aravis::Camera> camera_;
   std::vector<std::jthread> closing_;  // lost cameras being closed; joined when the node goes
   std::uint64_t count_ = 0, seq_ = 0;
-  int camera_id_ = 0;
+  std::string camera_name_;
   std::uint64_t seen_drops_ = 0, incomplete_ = 0, skipped_ = 0, base_incomplete_ = 0,
                 base_skipped_ = 0, reconnects_ = 0, losses_ = 0;
 };

@@ -22,6 +22,9 @@ class OpenPoseJsonSource : public Node {
                    "auto (detect BODY_25/BODY_25B by the keypoints), BODY_25, BODY_25B; 18 "
                    "keypoints are COCO-18 in any case");
     c.param<std::string>("stream", "", "stream id of the messages (default: the folder)");
+    c.param<std::string>("camera", std::string(kDefaultCamera),
+                         "the name of the camera the keypoints were detected in (as in the rig "
+                         "file, docs/cameras.md)");
   }
 
   void open(Context& ctx) override {
@@ -35,6 +38,7 @@ class OpenPoseJsonSource : public Node {
       std::cerr << ctx.node_name() << ": " << p.message << "\n";
     fps_ = ctx.param<double>("fps");
     stream_ = ctx.param<std::string>("stream");
+    camera_ = ctx.param<std::string>("camera");
     if (stream_.empty()) stream_ = ctx.param<std::string>("path");
     std::cerr << ctx.node_name() << ": " << sequence_.frames.size() << " frames, layout "
               << layout_name(sequence_.layout) << ", " << sequence_.problems.size()
@@ -48,6 +52,7 @@ class OpenPoseJsonSource : public Node {
     }
     People2D frame = std::move(sequence_.frames[next_]);
     frame.layout = sequence_.layout;
+    frame.camera = camera_;
     frame.header.stream = stream_;
     frame.header.seq = next_;
     frame.header.frame = static_cast<std::int64_t>(next_);
@@ -63,6 +68,7 @@ class OpenPoseJsonSource : public Node {
   std::size_t next_ = 0;
   double fps_ = 30.0;
   std::string stream_;
+  std::string camera_;
 };
 
 MOCAP_REGISTER_NODE("source.openpose_json", OpenPoseJsonSource)

@@ -19,14 +19,14 @@ class TestFrames : public Node {
     c.param<std::int64_t>("height", 480, "pixels", {1, 16384});
     c.param_choice("format", "rgb8", {"gray8", "rgb8", "bgr8", "rgba8", "bgra8"}, "pixel format");
     c.param<double>("fps", 0.0, "frames per second (0: as fast as possible)", {0, 1000});
-    c.param<std::int64_t>("camera", 0, "camera id", {0, 1000});
+    c.param<std::string>("camera", std::string(kDefaultCamera), "camera name (also the stream id)");
   }
 
   void open(Context& ctx) override {
     count_ = ctx.param<std::uint64_t>("count");
     width_ = ctx.param<int>("width");
     height_ = ctx.param<int>("height");
-    camera_ = ctx.param<int>("camera");
+    camera_ = ctx.param<std::string>("camera");
     format_ = pixel_format_from_name(ctx.param<std::string>("format")).value();  // a choice
     const double fps = ctx.param<double>("fps");
     interval_ = std::chrono::nanoseconds(fps > 0 ? static_cast<std::int64_t>(1e9 / fps) : 0);
@@ -36,9 +36,8 @@ class TestFrames : public Node {
     if (count_ != 0 && seq_ >= count_) return ctx.finish();
     if (seq_ > 0 && interval_.count() > 0 && !ctx.sleep_for(interval_)) return;
     VideoFrame frame;
-    frame.header = {"camera" + std::to_string(camera_), seq_, realtime_ns(),
-                    static_cast<std::int64_t>(seq_)};
-    frame.camera_id = camera_;
+    frame.header = {camera_, seq_, realtime_ns(), static_cast<std::int64_t>(seq_)};
+    frame.camera = camera_;
     frame.image = ImageBuffer(width_, height_, format_);
     const auto pixels = frame.image.pixels_for_writing();
     for (int row = 0; row < height_; ++row) {
@@ -52,7 +51,8 @@ class TestFrames : public Node {
 
  private:
   std::uint64_t count_ = 0, seq_ = 0;
-  int width_ = 0, height_ = 0, camera_ = 0;
+  int width_ = 0, height_ = 0;
+  std::string camera_;
   PixelFormat format_ = PixelFormat::rgb8;
   std::chrono::nanoseconds interval_{0};
 };

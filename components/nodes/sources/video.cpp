@@ -34,7 +34,8 @@ class VideoSourceNode : public Node {
     c.param<int>("height", 0, "devices: frame height to ask for (0: the device's)", {0, 16384});
     c.param<std::int64_t>("count", 0, "frames to send at most (0: all)", {0, 1e12});
     c.param<int>("timeout_ms", 10000, "network streams: open and read timeout", {100, 600000});
-    c.param<int>("camera", 0, "camera id in the messages", {0, 1000});
+    c.param<std::string>("camera", std::string(kDefaultCamera),
+                         "the camera's name in the messages (as in the rig file, docs/cameras.md)");
     c.param<std::string>("stream", "", "stream id of the messages (default: the path)");
     c.param<bool>("loop", false, "files and folders: start again at the end (counts the passes)");
   }
@@ -53,7 +54,7 @@ class VideoSourceNode : public Node {
     if (mode != "auto") playback.live = mode == "live";
     playback_.emplace(path, options, playback);
     count_ = ctx.param<std::uint64_t>("count");
-    camera_id_ = ctx.param<int>("camera");
+    camera_ = ctx.param<std::string>("camera");
     stream_ = ctx.param<std::string>("stream");
     if (stream_.empty()) stream_ = path;
     std::cerr << ctx.node_name() << ": " << playback_->describe() << "\n";
@@ -71,7 +72,7 @@ class VideoSourceNode : public Node {
     }
     VideoFrame message;
     message.header = {stream_, sent_, frame->stamp_ns, frame->frame.index};
-    message.camera_id = camera_id_;
+    message.camera = camera_;
     message.image = std::move(frame->frame.image);
     ctx.send("frames", std::move(message));
     ++sent_;
@@ -109,7 +110,7 @@ class VideoSourceNode : public Node {
 
   std::optional<video::Playback> playback_;
   std::uint64_t count_ = 0, sent_ = 0, late_ = 0, undecodable_ = 0, passes_ = 0;
-  int camera_id_ = 0;
+  std::string camera_;
   std::string stream_;
 };
 

@@ -1,22 +1,26 @@
-#include "camera/pose2sim_calibration.hpp"
+// The TOML side of rig_file.hpp: a parser of the TOML subset these files use (tables,
+// `key = value` with strings, numbers, booleans and nested arrays that may span lines, `#`
+// comments) and the writer.
 
+#include "camera/rig_file.hpp"
+
+#include <algorithm>
+#include <array>
 #include <charconv>
 #include <cmath>
-#include <fstream>
-#include <iterator>
 #include <map>
 #include <optional>
 #include <sstream>
-
-#include <glm/geometric.hpp>
+#include <stdexcept>
+#include <system_error>
+#include <vector>
 
 #include "core/input_error.hpp"
 
 namespace mocap::camera {
 namespace {
 
-constexpr std::uintmax_t kMaxFileBytes = 1u << 20;  // a calibration of many cameras is ~1 KB each
-constexpr int kMaxDepth = 8;                        // array nesting
+constexpr int kMaxDepth = 8;  // array nesting
 
 struct Value {
   enum class Kind { number, string, boolean, array } kind = Kind::number;
@@ -33,7 +37,7 @@ struct Table {
   std::map<std::string, Value, std::less<>> keys;
 };
 
-// The TOML subset of Pose2Sim's calibration files, parsed in one pass.
+// The TOML subset of the calibration files, parsed in one pass.
 class Parser {
  public:
   Parser(std::string_view text, const std::string& file) : text_(text), file_(file) {}
@@ -166,6 +170,17 @@ class Parser {
       }
       return v;
     }
+    if (c == '\'') {  // a literal string: no escapes
+      v.kind = Value::Kind::string;
+      ++pos_;
+      while (true) {
+        if (at_end() || text_[pos_] == '\n') fail(where + "unterminated string");
+        const char d = text_[pos_++];
+        if (d == '\'') break;
+        v.text += d;
+      }
+      return v;
+    }
     if (c == '[') {
       if (depth >= kMaxDepth) fail(where + "arrays nested too deeply");
       v.kind = Value::Kind::array;
@@ -226,6 +241,9 @@ class Keys {
   [[noreturn]] void fail(const std::string& key, const std::string& what) const {
     throw InputError(file_, get(key).line, "[" + table_.name + "] " + key + ": " + what);
   }
+  [[noreturn]] void fail_table(const std::string& what) const {
+    throw InputError(file_, table_.line, "[" + table_.name + "]: " + what);
+  }
   bool has(const std::string& key) const { return table_.keys.contains(key); }
 
   std::string string(const std::string& key) const {
@@ -237,6 +255,11 @@ class Keys {
     const Value& v = get(key);
     if (v.kind != Value::Kind::boolean) fail(key, "expected true or false");
     return v.boolean;
+  }
+  double number(const std::string& key) const {
+    const Value& v = get(key);
+    if (v.kind != Value::Kind::number) fail(key, "expected a number");
+    return v.number;
   }
   // A flat array of numbers; `count` < 0: any length.
   std::vector<double> numbers(const std::string& key, int count) const {
@@ -254,6 +277,7 @@ class Keys {
            "expected " + std::to_string(count) + " numbers, found " + std::to_string(out.size()));
     return out;
   }
+  // Row-major.
   std::array<double, 9> matrix3(const std::string& key) const {
     const Value& v = get(key);
     if (v.kind != Value::Kind::array || v.items.size() != 3) fail(key, "expected a 3x3 matrix");
@@ -264,95 +288,178 @@ class Keys {
     }
     return m;
   }
+  bool is_matrix(const std::string& key) const {
+    const Value& v = get(key);
+    return v.kind == Value::Kind::array && !v.items.empty() &&
+           v.items.front().kind == Value::Kind::array;
+  }
 
  private:
   const Table& table_;
   const std::string& file_;
 };
 
-Pose2SimCamera camera_of(const Table& table, const std::string& file) {
+bool all_zero(const std::vector<double>& values) {
+  for (const double v : values)
+    if (v != 0.0) return false;
+  return true;
+}
+
+glm::dmat3 from_row_major(const std::array<double, 9>& m) {
+  glm::dmat3 out;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) out[c][r] = m[static_cast<std::size_t>(3 * r + c)];
+  return out;
+}
+
+Camera camera_of(const Table& table, const std::string& file) {
   const Keys keys(table, file);
-  Pose2SimCamera cam;
-  cam.section = table.name;
-  cam.name = keys.string("name");
+  Camera cam;
+  cam.name = keys.has("name") ? keys.string("name") : table.name;
   const auto size = keys.numbers("size", 2);
   if (!(size[0] >= 1 && size[1] >= 1 && size[0] <= 1e5 && size[1] <= 1e5) ||
       size[0] != std::floor(size[0]) || size[1] != std::floor(size[1]))
-    keys.fail("size", "expected two positive whole numbers of pixels");
-  cam.intrinsics.width = static_cast<int>(size[0]);
-  cam.intrinsics.height = static_cast<int>(size[1]);
-  cam.intrinsics.K = keys.matrix3("matrix");
-  const auto& K = cam.intrinsics.K;
+    keys.fail("size", "expected two positive whole numbers of pixels [width, height]");
+  cam.width = static_cast<int>(size[0]);
+  cam.height = static_cast<int>(size[1]);
+  const auto K = keys.matrix3("matrix");
   if (!(K[0] > 0 && K[4] > 0) || K[3] != 0 || K[6] != 0 || K[7] != 0 || K[8] != 1)
-    keys.fail("matrix", "expected [[fx, s, cx], [0, fy, cy], [0, 0, 1]] with fx, fy > 0");
-  cam.intrinsics.distortion = keys.numbers("distortions", -1);
-  if (cam.intrinsics.distortion.size() > 14) keys.fail("distortions", "more than 14 coefficients");
-  const auto r = keys.numbers("rotation", 3);
-  cam.rotation = {r[0], r[1], r[2]};
+    keys.fail("matrix", "expected [[fx, 0, cx], [0, fy, cy], [0, 0, 1]] with fx, fy > 0");
+  if (std::abs(K[1]) > 1e-9 * K[0])
+    keys.fail("matrix",
+              "a skew (the 0 of the first row) is not supported: OpenCV's model has none");
+  cam.fx = K[0];
+  cam.cx = K[2];
+  cam.fy = K[4];
+  cam.cy = K[5];
+  if (keys.has("fisheye")) cam.fisheye = keys.boolean("fisheye");
+  cam.distortion = keys.numbers("distortions", -1);
+  if (all_zero(cam.distortion)) cam.distortion.clear();
+  if (keys.is_matrix("rotation")) {
+    cam.rotation = from_row_major(keys.matrix3("rotation"));
+    if (const std::string p = rotation_problem(cam.rotation); !p.empty())
+      keys.fail("rotation", "the matrix " + p);
+  } else {
+    const auto r = keys.numbers("rotation", 3);
+    cam.set_rodrigues({r[0], r[1], r[2]});
+  }
   const auto t = keys.numbers("translation", 3);
   cam.translation = {t[0], t[1], t[2]};
-  if (keys.has("fisheye")) cam.fisheye = keys.boolean("fisheye");
+  if (const std::string p = camera_problem(cam); !p.empty()) keys.fail_table("the camera " + p);
   return cam;
+}
+
+GroundPlane floor_of(const Table& table, const std::string& file) {
+  const Keys keys(table, file);
+  const auto n = keys.numbers("normal", 3);
+  GroundPlane floor{{n[0], n[1], n[2]}, keys.number("offset")};
+  if (const std::string p = ground_problem(floor); !p.empty())
+    keys.fail(p.substr(0, 6), p.substr(7));  // "normal ..." or "offset ..."
+  return floor;
+}
+
+// Tables that Pose2Sim does not take for cameras either.
+bool camera_table(const std::string& name) {
+  return name != "metadata" && !name.starts_with("metadata.") && name != "capture_volume" &&
+         name != "charuco" && name != "checkerboard";
+}
+
+// Shortest text that reads back to the same double, always with a decimal point or an exponent
+// (TOML tells floats from integers).
+std::string number_text(double v) {
+  char buffer[64];
+  const auto [end, ec] = std::to_chars(buffer, buffer + sizeof(buffer), v);
+  if (ec != std::errc()) throw std::runtime_error("format_rig_toml: cannot format a number");
+  std::string text(buffer, end);
+  if (text.find_first_of(".eE") == std::string::npos) text += ".0";
+  return text;
+}
+
+std::string array_text(const std::vector<double>& values) {
+  std::string out = "[";
+  for (const double v : values) {
+    out += ' ';
+    out += number_text(v);
+    out += ',';
+  }
+  out.back() = ']';  // the last comma, or the '[' of an empty array: "]" then
+  if (values.empty()) out = "[]";
+  return out;
+}
+
+std::string quoted(const std::string& text) {
+  std::string out = "\"";
+  for (const char c : text) {
+    if (c == '"' || c == '\\') out += '\\';
+    out += c;
+  }
+  return out + "\"";
 }
 
 }  // namespace
 
-glm::dmat3 rodrigues(const glm::dvec3& r) {
-  const double theta = glm::length(r);
-  if (theta < 1e-12) return glm::dmat3(1.0);
-  const glm::dvec3 k = r / theta;
-  const double c = std::cos(theta), s = std::sin(theta), C = 1.0 - c;
-  // glm is column-major: m[col][row].
-  glm::dmat3 m;
-  m[0] = {c + k.x * k.x * C, k.y * k.x * C + k.z * s, k.z * k.x * C - k.y * s};
-  m[1] = {k.x * k.y * C - k.z * s, c + k.y * k.y * C, k.z * k.y * C + k.x * s};
-  m[2] = {k.x * k.z * C + k.y * s, k.y * k.z * C - k.x * s, c + k.z * k.z * C};
-  return m;
-}
-
-glm::dmat3 Pose2SimCamera::rotation_matrix() const { return rodrigues(rotation); }
-
-glm::dvec3 Pose2SimCamera::to_camera(const glm::dvec3& world) const {
-  return rotation_matrix() * world + translation;
-}
-
-glm::dvec3 Pose2SimCamera::centre() const {
-  return -(glm::transpose(rotation_matrix()) * translation);
-}
-
-glm::dvec2 Pose2SimCamera::project(const glm::dvec3& world) const {
-  const glm::dvec3 c = to_camera(world);
-  const auto& K = intrinsics.K;
-  const double x = c.x / c.z, y = c.y / c.z;
-  return {K[0] * x + K[1] * y + K[2], K[4] * y + K[5]};
-}
-
-std::vector<Pose2SimCamera> parse_pose2sim_calibration(std::string_view text,
-                                                       const std::string& file_name) {
+Rig parse_rig_toml(std::string_view text, const std::string& file_name) {
   if (text.find('\0') != std::string_view::npos)
-    throw InputError(file_name, "binary data (a NUL byte): not a TOML calibration file");
+    throw InputError(file_name, "binary data (a NUL byte): not a TOML rig file");
   const std::vector<Table> tables = Parser(text, file_name).parse();
-  std::vector<Pose2SimCamera> cameras;
-  for (const Table& table : tables)
-    if (table.name != "metadata") cameras.push_back(camera_of(table, file_name));
-  if (cameras.empty())
-    throw InputError(file_name, "no camera table ([cam_01] ...): not a Pose2Sim calibration");
-  return cameras;
+  Rig rig;
+  std::vector<long> lines;
+  for (const Table& table : tables) {
+    if (table.name == "metadata.floor") {
+      rig.floor = floor_of(table, file_name);
+    } else if (camera_table(table.name)) {
+      Camera cam = camera_of(table, file_name);
+      for (std::size_t i = 0; i < rig.cameras.size(); ++i)
+        if (rig.cameras[i].name == cam.name)
+          throw InputError(file_name, table.line,
+                           "[" + table.name + "]: camera name '" + cam.name +
+                               "' is also the camera of line " + std::to_string(lines[i]));
+      rig.cameras.push_back(std::move(cam));
+      lines.push_back(table.line);
+    }
+  }
+  if (rig.cameras.empty())
+    throw InputError(file_name, "no camera table ([cam_01] ...): not a rig or calibration file");
+  return rig;
 }
 
-std::vector<Pose2SimCamera> read_pose2sim_calibration(const std::filesystem::path& file) {
-  const std::string name = file.string();
-  std::error_code ec;
-  const auto bytes = std::filesystem::file_size(file, ec);
-  if (ec) throw InputError(name, "cannot be read: " + ec.message());
-  if (bytes > kMaxFileBytes)
-    throw InputError(
-        name, "larger than " + std::to_string(kMaxFileBytes) + " bytes: not a calibration file");
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw InputError(name, "cannot be opened");
-  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (text.empty()) throw InputError(name, "empty file");
-  return parse_pose2sim_calibration(text, name);
+std::string format_rig_toml(const Rig& rig) {
+  if (const std::string p = rig_problem(rig); !p.empty())
+    throw std::invalid_argument("format_rig_toml: " + p);
+  std::ostringstream out;
+  out << "# A camera rig (docs/cameras.md): Pose2Sim/anipose calibration layout, metres.\n"
+      << "# rotation: Rodrigues vector and translation: world -> camera (x_c = R x_w + t);\n"
+      << "# size: [width, height] in pixels; distortions: OpenCV's coefficients.\n";
+  // Tables cam_01, cam_02 ...: wide enough that anipose, which sorts the tables by name, keeps
+  // the rig's order.
+  const std::size_t digits = std::max<std::size_t>(2, std::to_string(rig.cameras.size()).size());
+  for (std::size_t i = 0; i < rig.cameras.size(); ++i) {
+    const Camera& c = rig.cameras[i];
+    std::string table = std::to_string(i + 1);
+    table.insert(0, digits - table.size(), '0');
+    const glm::dvec3 r = c.rodrigues();
+    // Pose2Sim and anipose pass the coefficients to OpenCV: none is written as four zeros.
+    const std::vector<double> d = c.distortion.empty() ? std::vector<double>(4, 0.0) : c.distortion;
+    out << "\n[cam_" << table << "]\n"
+        << "name = " << quoted(c.name) << "\n"
+        << "size = [ " << c.width << ", " << c.height << "]\n"
+        << "matrix = [ " << array_text({c.fx, 0.0, c.cx}) << ", " << array_text({0.0, c.fy, c.cy})
+        << ", " << array_text({0.0, 0.0, 1.0}) << "]\n"
+        << "distortions = " << array_text(d) << "\n"
+        << "rotation = " << array_text({r.x, r.y, r.z}) << "\n"
+        << "translation = " << array_text({c.translation.x, c.translation.y, c.translation.z})
+        << "\n"
+        << "fisheye = " << (c.fisheye ? "true" : "false") << "\n";
+  }
+  if (rig.floor) {
+    const GroundPlane& f = *rig.floor;
+    out << "\n# The floor in the world (mocap): points x with dot(normal, x) + offset = 0, normal "
+           "up.\n"
+        << "[metadata.floor]\n"
+        << "normal = " << array_text({f.normal.x, f.normal.y, f.normal.z}) << "\n"
+        << "offset = " << number_text(f.offset) << "\n";
+  }
+  return out.str();
 }
 
 }  // namespace mocap::camera
