@@ -9,6 +9,7 @@
 
 #include "detect/image_tensor.hpp"
 #include "detect/person_boxes.hpp"
+#include "detect/person_proposals.hpp"
 
 namespace mocap::detect {
 namespace {
@@ -28,6 +29,7 @@ void check(const TopDownOptions& o) {
     throw std::invalid_argument("crop_padding must lie in [1, 4]");
   if (o.min_keypoints < 1 || o.min_keypoints > kMovenetKeypoints)
     throw std::invalid_argument("min_keypoints must lie in [1, 17]");
+  if (o.detector_tiles < 1) throw std::invalid_argument("detector_tiles must be at least 1");
   if (o.workers < 1 || o.workers > 16) throw std::invalid_argument("workers must lie in [1, 16]");
 }
 
@@ -93,16 +95,9 @@ void TopDownDetector::warm_up() {
 
 std::vector<Detection> TopDownDetector::find_boxes(const ImageBuffer& frame) {
   const auto start = Clock::now();
-  image_batch(image_, 1, kCenternetInput, kCenternetInput);
-  fill_stretched(frame, image_, 0);
-  const std::vector<GraphTensor>& heads = boxes_->run(image_);
-  std::vector<Detection> found =
-      decode_centernet(heads[0], heads[1], kCenternetPersonClass, options_.min_box_score, -1);
-  const float sx = static_cast<float>(frame.width()) / kCenternetInput;
-  const float sy = static_cast<float>(frame.height()) / kCenternetInput;
-  for (Detection& d : found)
-    d.box = {d.box.x * sx, d.box.y * sy, d.box.width * sx, d.box.height * sy};
-  found = suppress_overlaps(std::move(found), options_.box_overlap);
+  std::vector<Detection> found = propose_people(
+      *boxes_, frame, {options_.min_box_score, options_.box_overlap, options_.detector_tiles},
+      image_);
   ++profile_.detector_runs;
   profile_.centernet += seconds_since(start);
   return found;

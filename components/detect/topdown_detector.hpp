@@ -33,6 +33,9 @@ struct TopDownOptions {
   int detect_every = 10;
   float min_box_score = 0.3f;  // CenterNet person score
   float box_overlap = 0.5f;    // detector boxes overlapping more are one (NMS)
+  // The person detector on the whole frame stretched (1) or on this many square tiles of a wide
+  // frame (person_proposals.hpp).
+  int detector_tiles = 1;
   // A detector box overlapping a followed person's box by more than this is that person.
   float followed_overlap = 0.3f;
   float crop_padding = 1.25f;       // crop side = longer box side × this

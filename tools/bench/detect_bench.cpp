@@ -13,6 +13,7 @@
 // ignored people (yellow) and the reference strategy's people (red, numbered) on a 50-px grid.
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -31,8 +32,11 @@
 #include <opencv2/imgproc.hpp>
 
 #include "cli_args.hpp"
+#include "detect/image_tensor.hpp"
 #include "detect/model_files.hpp"
 #include "detect/movenet_detector.hpp"
+#include "detect/person_boxes.hpp"
+#include "detect/person_proposals.hpp"
 #include "detect/tiled_detector.hpp"
 #include "detect/topdown_detector.hpp"
 #include "eval/detection_truth.hpp"
@@ -52,6 +56,7 @@ struct Strategy {
   std::function<void()> reset = [] {};
   // Top-down only: where its time went (zero elsewhere).
   std::function<detect::TopDownProfile()> profile = [] { return detect::TopDownProfile{}; };
+  std::optional<detect::TopDownOptions> topdown;  // a top-down strategy's settings
 };
 
 std::vector<std::string> split(const std::string& text, char sep) {
@@ -72,7 +77,8 @@ Strategy make_strategy(const std::string& spec, detect::Backend backend, int thr
     o.backend = backend;
     o.threads = threads;
     auto d = std::make_shared<detect::MovenetDetector>(detect::movenet_model_json(), o);
-    return {spec, [d](const ImageBuffer& f) { return d->detect(f); }};
+    return {spec, [d](const ImageBuffer& f) { return d->detect(f); }, [] {},
+            [] { return detect::TopDownProfile{}; }, std::nullopt};
   }
   if (parts.size() == 4 && parts[0] == "tiles") {
     detect::TileOptions o;
@@ -85,29 +91,44 @@ Strategy make_strategy(const std::string& spec, detect::Backend backend, int thr
     o.backend = backend;
     o.threads = threads;
     auto d = std::make_shared<detect::TiledDetector>(detect::movenet_model_json(), o);
-    return {spec, [d](const ImageBuffer& f) { return d->detect(f); }};
+    return {spec, [d](const ImageBuffer& f) { return d->detect(f); }, [] {},
+            [] { return detect::TopDownProfile{}; }, std::nullopt};
   }
-  if (parts.size() >= 3 && parts.size() <= 5 && parts[0] == "topdown") {
+  if (parts.size() >= 3 && parts[0] == "topdown") {
     detect::TopDownOptions o;
     if (parts[1] != "lightning" && parts[1] != "thunder")
-      throw std::invalid_argument("topdown:lightning|thunder:EVERY[:WORKERS[:THREADS]], got " +
-                                  spec);
+      throw std::invalid_argument(
+          "topdown:lightning|thunder:EVERY[:WORKERS[:THREADS]][:tTILES][:sSCORE], got " + spec);
     o.pose_model = parts[1] == "thunder" ? detect::SinglePoseModel::thunder
                                          : detect::SinglePoseModel::lightning;
     o.detect_every = std::stoi(parts[2]);
+    // Then WORKERS and THREADS, and anywhere tN (person detector on N tiles) and sX (its score
+    // threshold).
+    std::vector<std::string> numbers;
+    for (std::size_t i = 3; i < parts.size(); ++i) {
+      if (parts[i].size() > 1 && parts[i][0] == 't')
+        o.detector_tiles = std::stoi(parts[i].substr(1));
+      else if (parts[i].size() > 1 && parts[i][0] == 's')
+        o.min_box_score = std::stof(parts[i].substr(1));
+      else
+        numbers.push_back(parts[i]);
+    }
+    if (numbers.size() > 2)
+      throw std::invalid_argument(
+          "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES][:sSCORE], got " + spec);
     o.backend = backend;
-    o.threads = parts.size() == 5 ? std::stoi(parts[4]) : threads;
-    o.workers = parts.size() >= 4 ? std::stoi(parts[3]) : 1;
+    o.threads = numbers.size() == 2 ? std::stoi(numbers[1]) : threads;
+    o.workers = numbers.empty() ? 1 : std::stoi(numbers[0]);
     auto d = std::make_shared<detect::TopDownDetector>(
         o, detect::cached_model_json(detect::model_name(o.pose_model)),
         detect::cached_model_json("centernet"));
     d->warm_up();
     return {spec, [d](const ImageBuffer& f) { return d->detect(f); }, [d] { d->reset(); },
-            [d] { return d->profile(); }};
+            [d] { return d->profile(); }, o};
   }
   throw std::invalid_argument("unknown strategy '" + spec +
                               "' (multipose:SIZE, tiles:CxR:TILE:FRAME, "
-                              "topdown:MODEL:EVERY[:WORKERS[:THREADS]])");
+                              "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES][:sSCORE])");
 }
 
 // Every frame of a video, or the one image of a still.
@@ -279,6 +300,122 @@ json candidates(const std::string& input, const Run& reference, const std::vecto
   return {{"input", input}, {"min_height", min_height}, {"frames", frames}};
 }
 
+// Why each true person a top-down strategy missed was missed (--diagnose): its person detector
+// is run again on the annotated frames at the score floor `floor`, and each missed box is put in
+// one cause: (d) a person was found near it but their box matches at IoU < min_iou (nearest
+// IoU >= 0.3); (a) the detector proposed nothing near it (IoU >= 0.3) at any score >= floor; (b)
+// only below the strategy's threshold; (c) proposed above it, yet no person came out near it (the
+// keypoint stage rejected the crop, duplicate removal dropped it, or, between detector runs, no
+// crop was looked at there). Prints a Markdown table per strategy.
+void diagnose(const std::string& input, const eval::DetectionTruth& truth, const std::string& name,
+              const Run& r, const detect::TopDownOptions& o, detect::Backend backend, int threads,
+              float min_iou, float floor) {
+  detect::RunnerOptions ro;
+  ro.backend = backend;
+  ro.threads = threads;
+  detect::CenternetNetwork network(detect::cached_model_json("centernet"), ro);
+  detect::SinglePoseNetwork pose(o.pose_model,
+                                 detect::cached_model_json(detect::model_name(o.pose_model)), ro);
+  const detect::ProposalOptions used{o.min_box_score, o.box_overlap, o.detector_tiles};
+  detect::GraphTensor scratch, crop;
+  int alone_truths = 0, alone_counted = 0, alone_matched = 0;  // the proposals as the boxes
+  detect::ProposalOptions low = used;
+  low.min_score = floor;
+  std::map<std::string, int> causes;
+  std::map<std::string, std::pair<int, int>> by_height;  // found, all
+  std::array<int, 3> nearest{};                          // misses by nearest IoU bucket
+  int truths = 0;
+  Frames frames(input);
+  for (int i = 0;; ++i) {
+    auto f = frames.next();
+    if (!f) break;
+    const auto t = std::find_if(truth.frames.begin(), truth.frames.end(),
+                                [&](const eval::TruthFrame& tf) { return tf.frame == i; });
+    if (t == truth.frames.end()) continue;
+    const auto it = r.people.find(i);
+    const std::vector<Box2D> found =
+        it == r.people.end() ? std::vector<Box2D>{} : boxes(it->second);
+    const auto score = eval::score_frame(*t, found, min_iou);
+    const std::vector<detect::Detection> proposed =
+        detect::propose_people(network, *f, low, scratch);
+    std::vector<Box2D> kept;
+    for (const auto& d : proposed)
+      if (d.score >= used.min_score) kept.push_back(d.box);
+    const auto alone = eval::score_frame(*t, kept, min_iou);
+    alone_truths += alone.truths, alone_counted += alone.detections, alone_matched += alone.matched;
+    for (std::size_t k = 0; k < t->people.size(); ++k) {
+      const Box2D& box = t->people[k];
+      ++truths;
+      const bool hit = std::find(score.match.begin(), score.match.end(), static_cast<int>(k)) !=
+                       score.match.end();
+      const std::string band = box.height < 100   ? "< 100 px"
+                               : box.height < 150 ? "100-150 px"
+                               : box.height < 250 ? "150-250 px"
+                                                  : ">= 250 px";
+      by_height[band].second++;
+      if (hit) {
+        by_height[band].first++;
+        continue;
+      }
+      float near = 0;
+      for (const Box2D& b : found) near = std::max(near, detect::iou(b, box));
+      nearest[near < 0.1f ? 0 : near < 0.3f ? 1 : 2]++;
+      float best_score = -1, best_iou = 0.3f;    // the best proposal near the box
+      const detect::Detection* above = nullptr;  // the nearest passing the threshold
+      for (const auto& d : proposed) {
+        const float v = detect::iou(d.box, box);
+        if (v < 0.3f) continue;
+        best_score = std::max(best_score, d.score);
+        if (d.score >= used.min_score && v >= best_iou) above = &d, best_iou = v;
+      }
+      if (near >= 0.3f) {
+        causes["(d) found, box IoU 0.3-0.5"]++;
+      } else if (best_score < 0) {
+        causes["(a) no proposal near it"]++;
+      } else if (!above) {
+        causes["(b) proposal below threshold"]++;
+      } else {
+        // The keypoint stage on that proposal's crop, as the strategy runs it.
+        const detect::SquareRegion region = detect::square_around(above->box, o.crop_padding);
+        detect::image_batch(crop, 1, pose.input_size(), pose.input_size());
+        detect::fill_region(*f, region, crop, 0);
+        const detect::SinglePoseKeypoints kp = pose.run(crop).front();
+        std::array<Keypoint2D, detect::kMovenetKeypoints> points{};
+        int passing = 0;
+        float sum = 0;
+        for (int j = 0; j < detect::kMovenetKeypoints; ++j) {
+          const auto& [y, x, c] = kp[j];
+          if (c < o.min_keypoint_score) continue;
+          ++passing, sum += c;
+          points[j] = {region.cx - region.side / 2 + x * region.side,
+                       region.cy - region.side / 2 + y * region.side, c};
+        }
+        if (passing < o.min_keypoints || sum / std::max(1, passing) < o.min_person_score)
+          causes["(c1) proposed, crop's keypoints rejected"]++;
+        else if (detect::iou(detect::keypoint_box(points, 0.12f), box) < 0.3f)
+          causes["(c2) proposed, crop's keypoints on someone else"]++;
+        else
+          causes["(c3) proposed, person dropped (duplicate) or not looked for"]++;
+      }
+    }
+  }
+  std::printf("\n#### %s: why true people were missed (proposals at score >= %.2f, %d tile%s)\n\n",
+              name.c_str(), floor, used.tiles, used.tiles == 1 ? "" : "s");
+  std::printf("| cause | people | share of the %d true people |\n|---|---|---|\n", truths);
+  for (const auto& [cause, n] : causes)
+    std::printf("| %s | %d | %.3f |\n", cause.c_str(), n, static_cast<double>(n) / truths);
+  std::printf("\nThe proposals alone (score >= %.2f) as the boxes: recall %.3f, precision %.3f\n",
+              used.min_score, static_cast<double>(alone_matched) / std::max(1, alone_truths),
+              static_cast<double>(alone_matched) / std::max(1, alone_counted));
+  std::printf(
+      "\nMisses by the IoU of the nearest found person: < 0.1: %d, 0.1-0.3: %d, "
+      "0.3-0.5: %d\n\n| true height | recall |\n|---|---|\n",
+      nearest[0], nearest[1], nearest[2]);
+  for (const auto& [band, n] : by_height)
+    std::printf("| %s | %d / %d |\n", band.c_str(), n.first, n.second);
+  std::fflush(stdout);
+}
+
 // Where the top-down strategies' time went, in ms per frame.
 void print_profiles(const std::vector<std::string>& names, const std::vector<Run>& runs) {
   bool header = false;
@@ -335,6 +472,9 @@ int main(int argc, char** argv) {
       .flag("only-annotated",
             "detect on the annotated frames only (each one alone: no following between frames; "
             "quick, for making candidates)")
+      .option("diagnose", "FLOOR",
+              "for each top-down strategy, why each missed true person was missed: its person "
+              "detector again at this score floor (e.g. 0.05)")
       .option("draw", "DIR", "draw the annotated frames with the truth and the reference's people")
       .option("candidates", "DIR",
               "write the reference's boxes on the frames to annotate (30 spread over a video when "
@@ -364,11 +504,15 @@ int main(int argc, char** argv) {
       const std::vector<int> only = args.has("only-annotated") ? at : std::vector<int>{};
       std::vector<Run> runs;
       std::vector<std::string> names;
+      std::vector<std::optional<detect::TopDownOptions>> topdowns;
+      std::vector<detect::Backend> backends;
       for (const std::string& spec : split(args.get("strategies"), ',')) {
         for (const std::string& runtime : split(args.get("backends"), ',')) {
           const detect::Backend backend = detect::resolve_backend(detect::parse_backend(runtime));
           Strategy s = make_strategy(spec, backend, threads);
           runs.push_back(run(s, input, only));
+          topdowns.push_back(s.topdown);
+          backends.push_back(backend);
           names.push_back(spec + "@" + std::string(detect::backend_name(backend)));
           std::fprintf(stderr, "%s %s: %d frames, %.1f s\n", stem.c_str(), names.back().c_str(),
                        runs.back().frames, runs.back().seconds);
@@ -429,6 +573,11 @@ int main(int argc, char** argv) {
       }
       print_profiles(names, runs);
       std::fflush(stdout);
+      if (args.has("diagnose") && truth)
+        for (std::size_t s = 0; s < runs.size(); ++s)
+          if (topdowns[s])
+            diagnose(input, *truth, names[s], runs[s], *topdowns[s], backends[s], threads, min_iou,
+                     std::stof(args.get("diagnose")));
       report["inputs"].push_back({{"input", input}, {"rows", rows}});
     }
     if (args.has("json")) std::ofstream(args.get("json")) << report.dump(1) << "\n";

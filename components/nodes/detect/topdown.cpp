@@ -30,6 +30,10 @@ class TopDownNode : public Node {
                  {1, 1000});
     c.param<double>("min_box_score", 0.3, "CenterNet person boxes scoring below are ignored",
                     {0.0, 1.0});
+    c.param<int>("detector_tiles", 1,
+                 "person detector on the whole frame stretched (1) or on N square tiles of a "
+                 "wide frame, people keeping their shape",
+                 {1, 8});
     c.param<double>("min_person_score", 0.35,
                     "a crop whose passing keypoints score less on average shows nobody",
                     {0.0, 1.0});
@@ -59,6 +63,7 @@ class TopDownNode : public Node {
         model == "thunder" ? detect::SinglePoseModel::thunder : detect::SinglePoseModel::lightning;
     o.detect_every = ctx.param<int>("detect_every");
     o.min_box_score = ctx.param<float>("min_box_score");
+    o.detector_tiles = ctx.param<int>("detector_tiles");
     o.min_person_score = ctx.param<float>("min_person_score");
     o.min_keypoints = ctx.param<int>("min_keypoints");
     o.min_keypoint_score = ctx.param<float>("min_keypoint_score");

@@ -1,0 +1,60 @@
+#include "detect/person_proposals.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+
+#include "detect/image_tensor.hpp"
+
+namespace mocap::detect {
+
+std::vector<SquareRegion> proposal_tiles(int width, int height, int tiles) {
+  if (tiles < 1) throw std::invalid_argument("the person detector needs at least one tile");
+  const float w = static_cast<float>(width), h = static_cast<float>(height);
+  if (tiles == 1 || width == height) return {{w / 2, h / 2, 0.0f}};
+  const bool wide = width > height;
+  const float side = wide ? h : w, span = (wide ? w : h) - side;
+  std::vector<SquareRegion> out;
+  for (int i = 0; i < tiles; ++i) {
+    const float centre = side / 2 + span * static_cast<float>(i) / static_cast<float>(tiles - 1);
+    out.push_back(wide ? SquareRegion{centre, h / 2, side} : SquareRegion{w / 2, centre, side});
+  }
+  return out;
+}
+
+std::vector<Detection> propose_people(CenternetNetwork& network, const ImageBuffer& frame,
+                                      const ProposalOptions& options, GraphTensor& input) {
+  const std::vector<SquareRegion> tiles =
+      proposal_tiles(frame.width(), frame.height(), options.tiles);
+  const bool wide = frame.width() >= frame.height();
+  std::vector<Detection> all;
+  for (std::size_t t = 0; t < tiles.size(); ++t) {
+    const SquareRegion& r = tiles[t];
+    image_batch(input, 1, kCenternetInput, kCenternetInput);
+    if (r.side == 0) {
+      fill_stretched(frame, input, 0);
+    } else {
+      fill_region(frame, r, input, 0);
+    }
+    const std::vector<GraphTensor>& heads = network.run(input);
+    std::vector<Detection> found =
+        decode_centernet(heads[0], heads[1], kCenternetPersonClass, options.min_score, -1);
+    // This tile's share of the long side: up to the middle of its overlap with each neighbour.
+    const float centre = wide ? r.cx : r.cy;
+    const float low = t == 0 ? -1e9f : (centre + (wide ? tiles[t - 1].cx : tiles[t - 1].cy)) / 2;
+    const float high =
+        t + 1 == tiles.size() ? 1e9f : (centre + (wide ? tiles[t + 1].cx : tiles[t + 1].cy)) / 2;
+    const float sx = r.side == 0 ? static_cast<float>(frame.width()) / kCenternetInput
+                                 : r.side / kCenternetInput;
+    const float sy = r.side == 0 ? static_cast<float>(frame.height()) / kCenternetInput
+                                 : r.side / kCenternetInput;
+    const float x0 = r.side == 0 ? 0 : r.cx - r.side / 2, y0 = r.side == 0 ? 0 : r.cy - r.side / 2;
+    for (Detection& d : found) {
+      d.box = {x0 + d.box.x * sx, y0 + d.box.y * sy, d.box.width * sx, d.box.height * sy};
+      const float c = wide ? d.box.x + d.box.width / 2 : d.box.y + d.box.height / 2;
+      if (c >= low && c < high) all.push_back(d);
+    }
+  }
+  return suppress_overlaps(std::move(all), options.box_overlap);
+}
+
+}  // namespace mocap::detect

@@ -1,0 +1,34 @@
+#pragma once
+// Person boxes from MB3-CenterNet on a whole frame, optionally on overlapping square tiles.
+// Stretching a wide frame to the detector's square 512 × 512 input squeezes people sideways
+// (1280 × 720: by 0.40 across, 0.71 down) and shrinks them; square tiles of the frame's short
+// side keep their shape, and each tile keeps the detections whose centre lies in its own share of
+// the frame (the overlap split at its middle), so a person narrower than the overlap is found
+// whole by exactly one tile. The detections of all tiles are then thinned by NMS.
+
+#include <vector>
+
+#include "core/image_buffer.hpp"
+#include "detect/centernet.hpp"
+#include "detect/image_tensor.hpp"
+
+namespace mocap::detect {
+
+struct ProposalOptions {
+  float min_score = 0.3f;    // CenterNet person score
+  float box_overlap = 0.5f;  // boxes overlapping more are one (NMS)
+  // 1: the whole frame stretched to the input (the model's users' way). N > 1: N square tiles
+  // of the frame's short side spread evenly along its long side (none when the frame is square).
+  int tiles = 1;
+};
+
+// The square regions the detector sees for a frame of width × height (one stretched region is
+// returned as the frame's bounding square with side 0: callers stretch the whole frame).
+std::vector<SquareRegion> proposal_tiles(int width, int height, int tiles);
+
+// Person detections in frame pixels, best first. `input` is the network's input, reused between
+// calls. Throws std::invalid_argument for tiles < 1.
+std::vector<Detection> propose_people(CenternetNetwork& network, const ImageBuffer& frame,
+                                      const ProposalOptions& options, GraphTensor& input);
+
+}  // namespace mocap::detect
