@@ -29,7 +29,7 @@ bool Inbox::push(std::size_t port_index, Packet packet) {
     ++drops_;
     return false;
   }
-  port.items.push_back(Item{std::move(packet), next_arrival_++});
+  port.items.push_back(Item{std::move(packet), next_arrival_++, std::chrono::steady_clock::now()});
   if (!eos) ++port.data_items;
   max_depth_ = std::max(max_depth_, ++depth_);
   lock.unlock();
@@ -52,6 +52,11 @@ std::size_t Inbox::oldest(const std::vector<bool>* readable) const {
 // Called with the lock held; notifies producers after unlocking is left to the caller.
 Inbox::Delivery Inbox::take(std::size_t index) {
   Port& port = ports_[index];
+  if (!port.items.front().packet.is_end_of_stream()) {
+    wait_.add(std::chrono::duration_cast<std::chrono::nanoseconds>(
+                  std::chrono::steady_clock::now() - port.items.front().pushed)
+                  .count());
+  }
   Delivery delivery{index, std::move(port.items.front().packet)};
   port.items.pop_front();
   if (!delivery.packet.is_end_of_stream()) --port.data_items;

@@ -6,6 +6,7 @@
 //   drop_oldest(N)  N slots; when full the oldest waiting message is dropped (counted)
 // End of stream is never dropped and never waits: it is always queued behind the data.
 
+#include <array>
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
@@ -16,6 +17,7 @@
 
 #include "graph/graph_spec.hpp"
 #include "graph/packet.hpp"
+#include "graph/stats.hpp"
 
 namespace mocap::graph {
 
@@ -54,11 +56,15 @@ class Inbox {
   std::uint64_t drops() const;
   std::size_t depth() const;
   std::size_t max_depth() const;
+  // How long the messages taken lately waited in this inbox (push to pop), {p50, p95} in
+  // microseconds: a stage that cannot keep up shows here as a growing wait.
+  std::array<double, 2> wait_percentiles_us() const { return wait_.percentiles_us(); }
 
  private:
   struct Item {
     Packet packet;
     std::uint64_t arrival;
+    std::chrono::steady_clock::time_point pushed;
   };
   // The port whose front is oldest among the readable ones; ports_.size() when none.
   std::size_t oldest(const std::vector<bool>* readable) const;
@@ -77,6 +83,7 @@ class Inbox {
   std::uint64_t drops_ = 0;
   std::size_t depth_ = 0, max_depth_ = 0;
   bool closed_ = false;
+  LatencyWindow wait_;
 };
 
 }  // namespace mocap::graph

@@ -192,6 +192,10 @@ class NodeRunner final : public Context {
     s.p95_us = p95;
     s.queue_depth = inbox_.depth();
     s.max_queue_depth = inbox_.max_depth();
+    const auto [wait50, wait95] = inbox_.wait_percentiles_us();
+    s.wait_p50_us = wait50;
+    s.wait_p95_us = wait95;
+    s.blocked_s = static_cast<double>(blocked_ns_.load()) * 1e-9;
     {
       const std::lock_guard lock(status_mutex_);  // the synchroniser's counters change as it runs
       s.sync = sync_stats_;
@@ -282,7 +286,8 @@ class NodeRunner final : public Context {
   Clock::time_point sync_published_{};
 
   std::atomic<std::uint64_t> in_{0}, out_{0}, own_drops_{0};
-  std::uint64_t abandoned_at_stop_ = 0;  // data left in the inbox after the drain deadline
+  std::atomic<std::int64_t> blocked_ns_{0};  // waiting for room downstream (send_packet)
+  std::uint64_t abandoned_at_stop_ = 0;      // data left in the inbox after the drain deadline
   std::atomic<int> state_{waiting};
   std::atomic<bool> thread_finished_{false};
   LatencyWindow latency_;
@@ -304,7 +309,9 @@ void NodeRunner::send_packet(std::string_view port, Packet packet) {
   // left out of the processing time, as sleeping is.
   const auto push_start = Clock::now();
   for (auto& [inbox, input] : out.local) inbox->push(input, packet);
-  slept_ += Clock::now() - push_start;
+  const auto pushing = Clock::now() - push_start;
+  slept_ += pushing;
+  blocked_ns_ += std::chrono::duration_cast<std::chrono::nanoseconds>(pushing).count();
   for (RemoteOutput& remote : out.remote) {
     const auto give_up = [&] { return remote.lossy || runtime_.drain_expired(); };
     if (!remote.sender->send(packet, give_up)) ++own_drops_;

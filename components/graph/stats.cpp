@@ -48,16 +48,19 @@ std::string format_sync_stats(const SyncStats& sync) {
 
 std::string format_stats_table(const GraphStats& stats) {
   std::ostringstream out;
-  char line[256];
-  std::snprintf(line, sizeof line, "%-16s %-20s %10s %10s %8s %10s %10s %6s %6s  %s\n", "node",
-                "type", "in", "out", "drops", "p50 us", "p95 us", "queue", "max", "state");
+  char line[320];
+  std::snprintf(line, sizeof line, "%-16s %-20s %10s %10s %8s %10s %10s %6s %6s %9s %9s %8s  %s\n",
+                "node", "type", "in", "out", "drops", "p50 us", "p95 us", "queue", "max",
+                "wait p50", "wait p95", "blocked", "state");
   out << line;
   for (const NodeStats& n : stats.nodes) {
-    std::snprintf(line, sizeof line,
-                  "%-16s %-20s %10llu %10llu %8llu %10.1f %10.1f %6zu %6zu  %s\n", n.node.c_str(),
-                  n.type.c_str(), static_cast<unsigned long long>(n.in),
-                  static_cast<unsigned long long>(n.out), static_cast<unsigned long long>(n.drops),
-                  n.p50_us, n.p95_us, n.queue_depth, n.max_queue_depth, n.state.c_str());
+    std::snprintf(
+        line, sizeof line,
+        "%-16s %-20s %10llu %10llu %8llu %10.1f %10.1f %6zu %6zu %7.1fms %7.1fms %7.2fs  %s\n",
+        n.node.c_str(), n.type.c_str(), static_cast<unsigned long long>(n.in),
+        static_cast<unsigned long long>(n.out), static_cast<unsigned long long>(n.drops), n.p50_us,
+        n.p95_us, n.queue_depth, n.max_queue_depth, n.wait_p50_us / 1000.0, n.wait_p95_us / 1000.0,
+        n.blocked_s, n.state.c_str());
     out << line;
     if (!n.status.empty()) out << "  " << n.node << ": " << n.status << "\n";
     if (!n.sync.inputs.empty()) out << "  " << n.node << ": " << format_sync_stats(n.sync) << "\n";

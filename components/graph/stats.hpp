@@ -46,6 +46,11 @@ struct NodeStats {
   std::string state;   // "running", "done", "failed"
   std::string status;  // the node's latest status line (Context::report_status), e.g. a reconnect
   SyncStats sync{};    // joined inputs only; in-process (not in the wire format's GraphStats)
+  // In-process only (not in the wire format's GraphStats), to find the stage a live graph queues
+  // behind: how long messages waited in this node's inputs ({p50, p95} over the last samples),
+  // and how long in all this node waited for room in a full blocking queue downstream.
+  double wait_p50_us = 0, wait_p95_us = 0;
+  double blocked_s = 0;
 
   bool operator==(const NodeStats&) const = default;
 };

@@ -127,6 +127,37 @@ edges:
   }
 }
 
+TEST(Scheduler, StatisticsShowWhereMessagesWaitAndWhoIsHeldBack) {
+  TempDir dir;
+  // 60 messages as fast as possible into a 5 ms stage behind blocking(4): the stage's input
+  // queue is full, each message waits there about 4 x 5 ms, and the pass-through feeding it
+  // spends most of the run waiting for room (back-pressure), not working.
+  const RunResult result = run(R"(
+nodes:
+  src:  { type: test.counter, params: { count: 60 } }
+  feed: { type: flow.pass_through }
+  slow: { type: test.delay, params: { delay_ms: 5 } }
+  sink: { type: test.collect, params: { path: )" +
+                               dir.file("out.txt") + R"( } }
+edges:
+  - [src.out, feed.in]
+  - [feed.out, slow.in, { policy: blocking(4) }]
+  - [slow.out, sink.in]
+)");
+  ASSERT_TRUE(result.ok) << result.error;
+  const NodeStats& slow = stats_of(result, "slow");
+  const NodeStats& feed = stats_of(result, "feed");
+  const NodeStats& sink = stats_of(result, "sink");
+  EXPECT_GT(slow.wait_p50_us, 10'000.0);  // about 4 messages x 5 ms ahead of each
+  EXPECT_GE(slow.wait_p95_us, slow.wait_p50_us);
+  EXPECT_LT(sink.wait_p50_us, slow.wait_p50_us);  // the sink keeps up
+  EXPECT_GT(feed.blocked_s, 0.1);                 // ~55 messages x 5 ms held back
+  EXPECT_LT(slow.blocked_s, 0.1);                 // nothing downstream of it is full
+  const std::string table = format_stats_table(result.stats);
+  EXPECT_NE(table.find("wait p95"), std::string::npos) << table;
+  EXPECT_NE(table.find("blocked"), std::string::npos) << table;
+}
+
 TEST(Scheduler, DropOldestKeepsTheNewestAndCountsDrops) {
   TempDir dir;
   const RunResult result = run(R"(
