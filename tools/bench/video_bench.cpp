@@ -7,7 +7,8 @@
 //    frames per second, people per frame, tracks longer than 50 frames, id breaks and jumps;
 //  * live: the file replayed at its own rate like a camera, the detector on a `latest` edge and
 //    the 1-Euro smoother (graphs/live_webcam.yaml): latency from capture time to 3D output
-//    (p50/p95), frames the detector kept up with, drops.
+//    (p50/p95), frames the detector kept up with, drops; the selector's look-ahead is --live-lag
+//    (0 by default: each frame of look-ahead costs a detector period of latency).
 // Prints Markdown tables. A probe node in this program records what reaches the outputs.
 
 #include <algorithm>
@@ -174,6 +175,7 @@ struct RunSpec {
   std::string backend = "auto";
   int workers = 1;
   int lag = 8;
+  bool print_stats = false;  // the runtime's per-node table (queues, waits) to stderr
 };
 
 std::string detector_node(const RunSpec& s) {
@@ -252,6 +254,9 @@ Result run(const RunSpec& s) {
   const double wall =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   if (!result.ok) throw std::runtime_error(result.error);
+  if (s.print_stats) {
+    std::cerr << s.out_dir << ":\n" << format_stats_table(result.stats);
+  }
   const Records r = read_records(probe);
   Result out;
   out.frames = info.frame_count();
@@ -333,7 +338,14 @@ int main(int argc, char** argv) {
               "detector workers (network copies: on consecutive frames for multipose, sharing a "
               "frame's crops for topdown; not tiles)",
               "1")
-      .option("lag", "N", "temporal selection look-ahead in frames", "8")
+      .option("lag", "N", "temporal selection look-ahead in frames, offline runs", "8")
+      .option("live-lag", "N",
+              "the same for live runs: it holds each frame until N more have been detected, i.e. "
+              "N x the detector's period (docs/detection-strategies.md, 2026-11-26)",
+              "0")
+      .flag("stats",
+            "print each run's per-node statistics to stderr (queue depth, how long messages "
+            "waited in each node's inputs, time blocked on a full queue downstream)")
       .option("out", "DIR", "where each run's outputs go", "/tmp/mocap-bench-video");
   int exit_code = 0;
   if (!args.parse(argc - 1, argv + 1, exit_code)) return exit_code;
@@ -371,9 +383,11 @@ int main(int argc, char** argv) {
           if (!size.empty()) spec.size = std::stoi(size);
           spec.live = mode == "live";
           spec.detector_threads = std::stoi(threads);
-          spec.lag = std::stoi(args.get("lag"));
+          spec.lag = std::stoi(args.get(spec.live ? "live-lag" : "lag"));
+          spec.print_stats = args.has("stats");
           spec.out_dir = args.get("out") + "/" + std::filesystem::path(video).stem().string() +
-                         "_" + label + "_" + backend + "_w" + workers + "_t" + threads + "_" + mode;
+                         "_" + label + "_" + backend + "_w" + workers + "_t" + threads + "_" +
+                         mode + "_lag" + std::to_string(spec.lag);
           const Result r = run(spec);
           std::cout << std::fixed << std::setprecision(1) << "| "
                     << std::filesystem::path(video).filename().string() << " | " << label << " | "
