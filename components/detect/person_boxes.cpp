@@ -43,18 +43,28 @@ Box2D keypoint_box(const std::array<Keypoint2D, kMovenetKeypoints>& keypoints, f
   return {x0 - grow / 2, y0 - grow, (x1 - x0) + grow, h + 1.5f * grow};
 }
 
+std::vector<std::size_t> distinct_people(std::span<const MovenetPerson> people, float max_iou,
+                                         float near) {
+  std::vector<std::size_t> order(people.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return people[a].score > people[b].score; });
+  std::vector<std::size_t> kept;
+  for (const std::size_t i : order) {
+    const bool duplicate = std::any_of(kept.begin(), kept.end(), [&](std::size_t k) {
+      return iou(people[k].box, people[i].box) > max_iou ||
+             same_keypoints(people[k], people[i], near);
+    });
+    if (!duplicate) kept.push_back(i);
+  }
+  return kept;
+}
+
 std::vector<MovenetPerson> remove_duplicates(std::vector<MovenetPerson> people, float max_iou,
                                              float near) {
-  std::stable_sort(
-      people.begin(), people.end(),
-      [](const MovenetPerson& a, const MovenetPerson& b) { return a.score > b.score; });
   std::vector<MovenetPerson> kept;
-  for (MovenetPerson& p : people) {
-    const bool duplicate = std::any_of(kept.begin(), kept.end(), [&](const MovenetPerson& k) {
-      return iou(k.box, p.box) > max_iou || same_keypoints(k, p, near);
-    });
-    if (!duplicate) kept.push_back(std::move(p));
-  }
+  for (const std::size_t i : distinct_people(people, max_iou, near))
+    kept.push_back(std::move(people[i]));
   return kept;
 }
 

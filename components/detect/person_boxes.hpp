@@ -3,6 +3,8 @@
 // removal of duplicates (the same person found by two tiles, two crops or two detectors).
 
 #include <array>
+#include <cstddef>
+#include <span>
 #include <vector>
 
 #include "detect/movenet_decoder.hpp"
@@ -19,5 +21,8 @@ Box2D keypoint_box(const std::array<Keypoint2D, kMovenetKeypoints>& keypoints, f
 // when half of the keypoints both have lie within `near` × the kept person's box height.
 std::vector<MovenetPerson> remove_duplicates(std::vector<MovenetPerson> people, float max_iou,
                                              float near = 0.05f);
+// The same choice as indices into `people`: those kept, best first.
+std::vector<std::size_t> distinct_people(std::span<const MovenetPerson> people, float max_iou,
+                                         float near = 0.05f);
 
 }  // namespace mocap::detect

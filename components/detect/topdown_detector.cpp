@@ -31,6 +31,9 @@ void check(const TopDownOptions& o) {
     throw std::invalid_argument("min_keypoints must lie in [1, 17]");
   if (o.detector_tiles < 1) throw std::invalid_argument("detector_tiles must be at least 1");
   if (o.workers < 1 || o.workers > 16) throw std::invalid_argument("workers must lie in [1, 16]");
+  if (o.keypoint_every < 1) throw std::invalid_argument("keypoint_every must be at least 1");
+  if (!(o.flow_error > 0.0f && o.flow_error <= 1.0f))
+    throw std::invalid_argument("flow_error must lie in (0, 1]");
 }
 
 RunnerOptions runner_options(const TopDownOptions& o) {
@@ -43,6 +46,13 @@ RunnerOptions runner_options(const TopDownOptions& o) {
 
 Box2D moved(const Box2D& box, float dx, float dy) {
   return {box.x + dx, box.y + dy, box.width, box.height};
+}
+
+// The median of `values` (reordered); `values` is not empty.
+float median(std::vector<float>& values) {
+  const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+  std::nth_element(values.begin(), middle, values.end());
+  return *middle;
 }
 
 // Waits for the `count` oldest jobs of `helpers`, then rethrows the first error (`error`, then
@@ -69,6 +79,7 @@ TopDownDetector::TopDownDetector(const TopDownOptions& options,
     poses_.push_back(std::make_unique<SinglePoseNetwork>(options_.pose_model, pose_model_json,
                                                          runner_options(options_)));
   if (options_.workers > 1) helpers_ = std::make_unique<OrderedWorkers<int>>(options_.workers - 1);
+  if (options_.keypoint_every > 1) flow_ = std::make_unique<KeypointFlow>();
 }
 
 TopDownDetector::~TopDownDetector() = default;
@@ -77,6 +88,7 @@ void TopDownDetector::reset() {
   followed_.clear();
   frame_ = 0;
   lost_someone_ = false;
+  if (flow_) flow_->reset();
 }
 
 void TopDownDetector::warm_up() {
@@ -145,8 +157,7 @@ void TopDownDetector::add_crops(const ImageBuffer& frame, std::span<const Box2D>
   run_keypoints(first, count, copies);
   profile_.keypoints += seconds_since(start);
 }
-std::vector<MovenetPerson> TopDownDetector::people_found() const {
-  std::vector<MovenetPerson> people;
+void TopDownDetector::people_found(std::vector<Found>& found) const {
   for (std::size_t i = 0; i < found_.size(); ++i) {
     const SquareRegion& r = regions_[i];
     MovenetPerson person;
@@ -167,16 +178,80 @@ std::vector<MovenetPerson> TopDownDetector::people_found() const {
     person.score = sum / static_cast<float>(passing);
     if (person.score < options_.min_person_score) continue;
     person.box = keypoint_box(person.keypoints, kHeadMargin);
-    people.push_back(person);
+    found.push_back({person, 0});
   }
-  return remove_duplicates(std::move(people), options_.duplicate_overlap);
+}
+
+void TopDownDetector::carry(std::vector<Found>& out) {
+  carried_.assign(followed_.size(), 0);
+  if (!flow_ || !flow_->ready()) return;
+  const auto start = Clock::now();
+  const auto due_carry = [&](const Followed& f) { return f.carried + 1 < options_.keypoint_every; };
+  flow_from_.clear();
+  flow_limit_.clear();
+  for (const Followed& f : followed_) {
+    if (!due_carry(f)) continue;
+    const float limit = std::max(1.0f, options_.flow_error * f.person.box.height);
+    for (const Keypoint2D& k : f.person.keypoints) {
+      if (!(k.confidence > 0) || !std::isfinite(k.x) || !std::isfinite(k.y)) continue;
+      flow_from_.push_back({k.x, k.y});
+      flow_limit_.push_back(limit);
+    }
+  }
+  flow_to_.resize(flow_from_.size());
+  flow_ok_.resize(flow_from_.size());
+  flow_->track(flow_from_, flow_limit_, flow_to_, flow_ok_);
+  std::size_t next = 0;  // the first point of the person in hand
+  for (std::size_t i = 0; i < followed_.size(); ++i) {
+    const Followed& f = followed_[i];
+    if (!due_carry(f)) continue;
+    // The points that flowed there and back; the person moves by their median motion.
+    MovenetPerson person = f.person;
+    const std::size_t first = next;
+    flow_dx_.clear();
+    flow_dy_.clear();
+    for (const Keypoint2D& k : person.keypoints) {
+      if (!(k.confidence > 0) || !std::isfinite(k.x) || !std::isfinite(k.y)) continue;
+      const std::size_t p = next++;
+      if (!flow_ok_[p]) continue;
+      flow_dx_.push_back(flow_to_[p].x - flow_from_[p].x);
+      flow_dy_.push_back(flow_to_[p].y - flow_from_[p].y);
+    }
+    if (static_cast<int>(flow_dx_.size()) < options_.min_keypoints) {
+      ++profile_.flow_failed;
+      continue;
+    }
+    const float dx = median(flow_dx_), dy = median(flow_dy_);
+    // A keypoint whose own flow failed the check (hidden, blurred) follows the person, so the
+    // skeleton and its box keep their shape until the next keypoint pass.
+    std::size_t p = first;
+    for (Keypoint2D& k : person.keypoints) {
+      if (!(k.confidence > 0) || !std::isfinite(k.x) || !std::isfinite(k.y)) continue;
+      k.x = flow_ok_[p] ? flow_to_[p].x : k.x + dx;
+      k.y = flow_ok_[p] ? flow_to_[p].y : k.y + dy;
+      ++p;
+    }
+    person.box = moved(person.box, dx, dy);
+    out.push_back({person, f.carried + 1});
+    carried_[i] = 1;
+    ++profile_.carried;
+  }
+  profile_.flow += seconds_since(start);
 }
 
 std::vector<MovenetPerson> TopDownDetector::detect(const ImageBuffer& frame) {
   const auto start = Clock::now();
-  // Where each followed person should be now.
+  if (flow_) {
+    const auto flowing = Clock::now();
+    flow_->next_frame(frame);
+    profile_.flow += seconds_since(flowing);
+  }
+  // The people carried by optical flow; where each other followed person should be now.
+  std::vector<Found> found;
+  carry(found);
   std::vector<Box2D> boxes;
-  for (const Followed& f : followed_) boxes.push_back(moved(f.box, f.vx, f.vy));
+  for (std::size_t i = 0; i < followed_.size(); ++i)
+    if (!carried_[i]) boxes.push_back(moved(followed_[i].box, followed_[i].vx, followed_[i].vy));
   const bool run_detector =
       frame_ % options_.detect_every == 0 || lost_someone_ || followed_.empty();
   ++frame_;
@@ -207,20 +282,37 @@ std::vector<MovenetPerson> TopDownDetector::detect(const ImageBuffer& frame) {
       detections = find_boxes(frame);
       profile_.centernet_wait += seconds_since(running);
     }
+    const std::size_t followed = boxes.size();
     for (const Detection& d : detections) {
-      const bool followed = std::any_of(boxes.begin(), boxes.end(), [&](const Box2D& b) {
+      const auto overlaps = [&](const Box2D& b) {
         return iou(b, d.box) > options_.followed_overlap;
-      });
-      if (!followed) boxes.push_back(d.box);
+      };
+      const bool known =
+          std::any_of(boxes.begin(), boxes.begin() + static_cast<std::ptrdiff_t>(followed),
+                      overlaps) ||
+          std::any_of(found.begin(), found.end(),
+                      [&](const Found& c) { return overlaps(c.person.box); });
+      if (!known) boxes.push_back(d.box);
     }
   }
   add_crops(frame, std::span<const Box2D>(boxes).subspan(cropped), copies);
-  std::vector<MovenetPerson> people = people_found();
+  people_found(found);
+  std::vector<MovenetPerson> people;
+  std::vector<int> carried;  // per person: frames since their keypoint pass
+  {
+    std::vector<MovenetPerson> candidates;
+    for (const Found& f : found) candidates.push_back(f.person);
+    for (const std::size_t i : distinct_people(candidates, options_.duplicate_overlap)) {
+      people.push_back(found[i].person);
+      carried.push_back(found[i].carried);
+    }
+  }
 
   // The next frame's crops: each person's box, moved by how far their nearest predecessor moved.
   std::vector<Followed> next;
-  for (const MovenetPerson& p : people) {
-    Followed f{p.box, 0, 0};
+  for (std::size_t i = 0; i < people.size(); ++i) {
+    const MovenetPerson& p = people[i];
+    Followed f{p.box, 0, 0, p, carried[i]};
     const float cx = p.box.x + p.box.width / 2, cy = p.box.y + p.box.height / 2;
     float best = 0.3f;  // the predecessor must overlap the person this much
     for (const Followed& old : followed_) {

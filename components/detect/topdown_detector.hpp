@@ -11,7 +11,12 @@
 // share each, the calling thread runs one), and on a frame where the person detector runs it runs
 // on a helper thread while the calling thread does the crops of the people already followed
 // (measured against one two-thread network in docs/detection-strategies.md).
+//
+// Live: with keypoint_every K > 1 a followed person gets a keypoint pass only every K frames;
+// on the frames between, their keypoints are carried by sparse optical flow with a forward-
+// backward check (keypoint_flow.hpp), and a person whose flow fails gets a crop at once.
 
+#include <cstdint>
 #include <filesystem>
 #include <memory>
 #include <span>
@@ -20,6 +25,7 @@
 #include "core/image_buffer.hpp"
 #include "detect/centernet.hpp"
 #include "detect/image_tensor.hpp"
+#include "detect/keypoint_flow.hpp"
 #include "detect/movenet_decoder.hpp"
 #include "detect/ordered_workers.hpp"
 #include "detect/singlepose.hpp"
@@ -52,6 +58,14 @@ struct TopDownOptions {
   // Copies of the keypoint network, each on its own thread (the calling thread runs the first);
   // with more than one, `threads` 0 means 1 per copy.
   int workers = 1;
+  // A followed person's keypoints come from the keypoint network every keypoint_every frames
+  // (1: every frame) and are carried by optical flow in between: a keypoint's flow counts when
+  // flowed back it lands within max(1 px, flow_error x the person's box height) of where it
+  // started; with at least min_keypoints such, the person (box and keypoints whose flow failed)
+  // moves by their median motion, the others move by their own flow; with fewer the person gets a
+  // keypoint pass instead.
+  int keypoint_every = 1;
+  float flow_error = 0.03f;
 };
 
 // Where the time of detect() went, summed over the frames since the detector was made (seconds,
@@ -63,7 +77,10 @@ struct TopDownProfile {
   double centernet = 0;       // the person detector: frame stretched, forward, decoding, NMS
   double centernet_wait = 0;  // the calling thread running it or waiting for its helper
   double crop_fill = 0;       // crops cut out of the frame
-  double keypoints = 0;  // keypoint passes on the calling thread, waiting for the helpers included
+  double keypoints = 0;   // keypoint passes on the calling thread, waiting for the helpers included
+  long long carried = 0;  // people carried by optical flow instead of a keypoint pass
+  long long flow_failed = 0;  // people due to be carried whose flow failed (they got a crop)
+  double flow = 0;            // grey pyramids and optical flow
 };
 
 class TopDownDetector {
@@ -92,6 +109,14 @@ class TopDownDetector {
   struct Followed {
     Box2D box;             // the person's box in the last frame
     float vx = 0, vy = 0;  // motion of the box centre per frame
+    MovenetPerson person;  // their keypoints in the last frame
+    int carried = 0;       // frames since their last keypoint pass
+  };
+  // A person found in this frame and how many frames their keypoints have been carried (0: a
+  // keypoint pass).
+  struct Found {
+    MovenetPerson person;
+    int carried = 0;
   };
   std::vector<Detection> find_boxes(const ImageBuffer& frame);
   // Keypoints of a crop for each box, appended to found_ (regions_ gets their squares), the
@@ -99,7 +124,11 @@ class TopDownDetector {
   void add_crops(const ImageBuffer& frame, std::span<const Box2D> boxes, int copies);
   // Keypoints of crops_[0, count) into found_[first, first + count), on `copies` copies at once.
   void run_keypoints(int first, int count, int copies);
-  std::vector<MovenetPerson> people_found() const;
+  // People of the crops of this frame, appended to `found`.
+  void people_found(std::vector<Found>& found) const;
+  // The followed people due no keypoint pass moved into this frame by optical flow, appended to
+  // `out`; marks in carried_ which were (the others need a crop).
+  void carry(std::vector<Found>& out);
 
   TopDownOptions options_;
   std::vector<std::unique_ptr<SinglePoseNetwork>> poses_;  // copy 0 runs on the calling thread
@@ -109,6 +138,10 @@ class TopDownDetector {
   std::vector<SquareRegion> regions_;
   std::vector<SinglePoseKeypoints> found_;
   std::vector<Followed> followed_;
+  std::unique_ptr<KeypointFlow> flow_;  // with keypoint_every > 1
+  std::vector<FlowPoint> flow_from_, flow_to_;
+  std::vector<float> flow_limit_, flow_dx_, flow_dy_;
+  std::vector<std::uint8_t> flow_ok_, carried_;
   long long frame_ = 0;
   bool lost_someone_ = false;
   TopDownProfile profile_;

@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <memory>
@@ -127,12 +128,86 @@ TEST(TopDownDetector, PartOfABatchEqualsThatPartOfTheWholeRun) {
   EXPECT_THROW(network.run(batch, 4, 2, part), std::invalid_argument);
 }
 
+// Frames 0..5 of the moving picture with the keypoint network every `keypoint_every` frames.
+std::vector<std::vector<MovenetPerson>> run_carried(int keypoint_every, TopDownProfile& profile) {
+  std::string why;
+  const auto m = models(why);
+  TopDownOptions o;
+  o.detect_every = 3;
+  o.keypoint_every = keypoint_every;
+  TopDownDetector detector(o, m->lightning, m->centernet);
+  std::vector<std::vector<MovenetPerson>> out;
+  for (int i = 0; i < 6; ++i) out.push_back(detector.detect(shifted_frame(2 * i)));
+  profile = detector.profile();
+  return out;
+}
+
+TEST(TopDownDetector, KeypointsCarriedByFlowStayWithTheNetworksBetweenPasses) {
+  std::string why;
+  if (!models(why)) GTEST_SKIP() << why;
+  TopDownProfile every_profile, carried_profile;
+  const auto every = run_carried(1, every_profile);
+  const auto carried = run_carried(3, carried_profile);
+  EXPECT_EQ(every_profile.carried, 0);
+  EXPECT_EQ(every_profile.flow, 0.0);
+  // Passes on frames 0 and 3, flow on 1, 2, 4 and 5 for everyone the flow keeps.
+  EXPECT_GE(carried_profile.carried, 4 * 3);
+  EXPECT_LT(carried_profile.crops, every_profile.crops * 2 / 3);
+  EXPECT_GT(carried_profile.flow, 0.0);
+  std::vector<float> distances;
+  for (std::size_t f = 0; f < every.size(); ++f) {
+    SCOPED_TRACE(f);
+    EXPECT_EQ(carried[f].size(), every[f].size());
+    for (const MovenetPerson& a : carried[f]) {
+      // The same person of the every-frame run.
+      const MovenetPerson* b = nullptr;
+      for (const MovenetPerson& candidate : every[f])
+        if (iou(a.box, candidate.box) > 0.5f) b = &candidate;
+      ASSERT_NE(b, nullptr);
+      for (int k = 0; k < kMovenetKeypoints; ++k)
+        if (std::isfinite(a.keypoints[k].x) && std::isfinite(b->keypoints[k].x))
+          distances.push_back(std::hypot(a.keypoints[k].x - b->keypoints[k].x,
+                                         a.keypoints[k].y - b->keypoints[k].y));
+    }
+  }
+  ASSERT_FALSE(distances.empty());
+  std::sort(distances.begin(), distances.end());
+  // The picture moves exactly; what differs is the network's own jitter from crop to crop.
+  EXPECT_LT(distances[distances.size() / 2], 1.5f);
+}
+
+TEST(TopDownDetector, APersonWhoseFlowFailsGetsAKeypointPass) {
+  std::string why;
+  const auto m = models(why);
+  if (!m) GTEST_SKIP() << why;
+  TopDownOptions o;
+  o.detect_every = 100;
+  o.keypoint_every = 5;
+  TopDownDetector detector(o, m->lightning, m->centernet);
+  const auto first = detector.detect(shifted_frame(0));
+  ASSERT_GE(first.size(), 4u);
+  // A blank picture (the camera covered): no point can be followed, so nobody is carried; each
+  // gets a crop instead (which shows nobody).
+  auto blank = std::make_shared<cv::Mat>(576, 768, CV_8UC3, cv::Scalar(128, 128, 128));
+  const auto second = detector.detect(
+      ImageBuffer(blank->cols, blank->rows, static_cast<int>(blank->step[0]), PixelFormat::bgr8,
+                  blank, reinterpret_cast<const std::byte*>(blank->data)));
+  EXPECT_TRUE(second.empty());
+  const TopDownProfile& p = detector.profile();
+  EXPECT_EQ(p.carried, 0);
+  EXPECT_EQ(p.flow_failed, static_cast<long long>(first.size()));
+  EXPECT_GE(p.crops, 2 * static_cast<long long>(first.size()));
+}
+
 TEST(TopDownDetector, WorkersOutsideTheRangeAreRefused) {
   std::string why;
   const auto m = models(why);
   if (!m) GTEST_SKIP() << why;
   TopDownOptions o;
   o.workers = 0;
+  EXPECT_THROW(TopDownDetector(o, m->lightning, m->centernet), std::invalid_argument);
+  o.workers = 1;
+  o.keypoint_every = 0;
   EXPECT_THROW(TopDownDetector(o, m->lightning, m->centernet), std::invalid_argument);
 }
 

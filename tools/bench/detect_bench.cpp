@@ -98,7 +98,8 @@ Strategy make_strategy(const std::string& spec, detect::Backend backend, int thr
     detect::TopDownOptions o;
     if (parts[1] != "lightning" && parts[1] != "thunder")
       throw std::invalid_argument(
-          "topdown:lightning|thunder:EVERY[:WORKERS[:THREADS]][:tTILES][:sSCORE], got " + spec);
+          "topdown:lightning|thunder:EVERY[:WORKERS[:THREADS]][:tTILES][:sSCORE][:kEVERY], got " +
+          spec);
     o.pose_model = parts[1] == "thunder" ? detect::SinglePoseModel::thunder
                                          : detect::SinglePoseModel::lightning;
     o.detect_every = std::stoi(parts[2]);
@@ -110,12 +111,14 @@ Strategy make_strategy(const std::string& spec, detect::Backend backend, int thr
         o.detector_tiles = std::stoi(parts[i].substr(1));
       else if (parts[i].size() > 1 && parts[i][0] == 's')
         o.min_box_score = std::stof(parts[i].substr(1));
+      else if (parts[i].size() > 1 && parts[i][0] == 'k')
+        o.keypoint_every = std::stoi(parts[i].substr(1));
       else
         numbers.push_back(parts[i]);
     }
     if (numbers.size() > 2)
       throw std::invalid_argument(
-          "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES][:sSCORE], got " + spec);
+          "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES][:sSCORE][:kEVERY], got " + spec);
     o.backend = backend;
     o.threads = numbers.size() == 2 ? std::stoi(numbers[1]) : threads;
     o.workers = numbers.empty() ? 1 : std::stoi(numbers[0]);
@@ -126,9 +129,10 @@ Strategy make_strategy(const std::string& spec, detect::Backend backend, int thr
     return {spec, [d](const ImageBuffer& f) { return d->detect(f); }, [d] { d->reset(); },
             [d] { return d->profile(); }, o};
   }
-  throw std::invalid_argument("unknown strategy '" + spec +
-                              "' (multipose:SIZE, tiles:CxR:TILE:FRAME, "
-                              "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES][:sSCORE])");
+  throw std::invalid_argument(
+      "unknown strategy '" + spec +
+      "' (multipose:SIZE, tiles:CxR:TILE:FRAME, "
+      "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES][:sSCORE][:kEVERY])");
 }
 
 // Every frame of a video, or the one image of a still.
@@ -174,6 +178,7 @@ detect::TopDownProfile minus(detect::TopDownProfile a, const detect::TopDownProf
   a.total -= b.total, a.centernet -= b.centernet, a.crop_fill -= b.crop_fill;
   a.centernet_wait -= b.centernet_wait;
   a.keypoints -= b.keypoints;
+  a.carried -= b.carried, a.flow_failed -= b.flow_failed, a.flow -= b.flow;
   return a;
 }
 
@@ -425,19 +430,21 @@ void print_profiles(const std::vector<std::string>& names, const std::vector<Run
     if (!header)
       std::printf(
           "\n| top-down strategy | crops/frame | detector runs | ms/frame: detect() | "
-          "CenterNet (per run; on the caller) | crop cutting | keypoint passes (per crop) | rest "
-          "|\n"
-          "|---|---|---|---|---|---|---|---|\n");
+          "CenterNet (per run; on the caller) | crop cutting | keypoint passes (per crop) | "
+          "optical flow | rest | carried by flow /frame (flow failed) |\n"
+          "|---|---|---|---|---|---|---|---|---|---|\n");
     header = true;
     const double f = static_cast<double>(p.frames);
-    const double rest = p.total - p.centernet_wait - p.crop_fill - p.keypoints;
+    const double rest = p.total - p.centernet_wait - p.crop_fill - p.keypoints - p.flow;
     std::printf(
-        "| %s | %.2f | %lld | %.1f | %.1f (%.1f; %.1f waited) | %.1f | %.1f (%.2f) | %.1f |\n",
+        "| %s | %.2f | %lld | %.1f | %.1f (%.1f; %.1f waited) | %.1f | %.1f (%.2f) | %.1f | %.1f "
+        "| %.2f (%lld) |\n",
         names[s].c_str(), static_cast<double>(p.crops) / f, p.detector_runs, 1e3 * p.total / f,
         1e3 * p.centernet / f,
         p.detector_runs ? 1e3 * p.centernet / static_cast<double>(p.detector_runs) : 0.0,
         1e3 * p.centernet_wait / f, 1e3 * p.crop_fill / f, 1e3 * p.keypoints / f,
-        p.crops ? 1e3 * p.keypoints / static_cast<double>(p.crops) : 0.0, 1e3 * rest / f);
+        p.crops ? 1e3 * p.keypoints / static_cast<double>(p.crops) : 0.0, 1e3 * p.flow / f,
+        1e3 * rest / f, static_cast<double>(p.carried) / f, p.flow_failed);
   }
 }
 
@@ -458,8 +465,11 @@ int main(int argc, char** argv) {
       .option("strategies", "LIST",
               "the first (on the first runtime) is the reference for keypoint distances: "
               "multipose:SIZE, "
-              "tiles:CxR:TILE:FRAME, topdown:lightning|thunder:EVERY[:WORKERS[:THREADS]] "
-              "(workers: copies of the keypoint network sharing a frame's crops; a top-down "
+              "tiles:CxR:TILE:FRAME, "
+              "topdown:lightning|thunder:EVERY[:WORKERS[:THREADS]][:tTILES][:sSCORE][:kEVERY] "
+              "(workers: copies of the keypoint network sharing a frame's crops; tTILES: person "
+              "detector tiles, sSCORE: its box score floor, kEVERY: keypoint pass every EVERY "
+              "frames, optical flow between; a top-down "
               "strategy also prints where its time went)",
               "topdown:thunder:1,multipose:256,multipose:512,tiles:2x2:256:256,"
               "topdown:lightning:1,topdown:lightning:10,topdown:thunder:10")

@@ -47,6 +47,10 @@ class TopDownNode : public Node {
                  "thread (2: both cores); the person detector then runs beside the followed "
                  "people's crops",
                  {1, 16});
+    c.param<int>("keypoint_every", 1,
+                 "live: a person's keypoint pass every N frames, carried by optical flow between "
+                 "(a person whose flow fails gets a pass at once); 1: every frame",
+                 {1, 100});
     c.param<bool>("warm_up", true,
                   "build the networks for every batch shape when the node opens, so that a live "
                   "source's first frames are not late");
@@ -72,10 +76,12 @@ class TopDownNode : public Node {
     o.backend = network.backend;
     o.threads = network.threads;
     o.workers = ctx.param<int>("workers");
+    o.keypoint_every = ctx.param<int>("keypoint_every");
     detector_.emplace(o, model_file(ctx, "pose_model_file", detect::model_name(o.pose_model)),
                       model_file(ctx, "box_model_file", "centernet"));
     std::cerr << "node '" << ctx.node_name() << "': top-down on "
-              << detect::backend_name(detector_->backend()) << ", " << o.workers << " worker(s)\n";
+              << detect::backend_name(detector_->backend()) << ", " << o.workers
+              << " worker(s), keypoint pass every " << o.keypoint_every << " frame(s)\n";
     if (ctx.param<bool>("warm_up")) detector_->warm_up();
   }
 
