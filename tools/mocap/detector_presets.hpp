@@ -22,8 +22,10 @@ const DetectorPreset& detector_preset(std::string_view name);
 
 // The defaults (docs/detection-strategies.md): for a file, find people first: top-down (recall
 // 0.80 against 0.02 for MultiPose 256 and 0.54 for 512 on vtest, faster than 512;
-// graphs/monocular_video.yaml carries it). For a live source, keep the rate: still MultiPose 256,
-// as its live latency with the other strategies is not measured yet. Each is a one-line change.
+// graphs/monocular_video.yaml carries it). For a live source, keep the rate: MultiPose 256, the
+// only strategy measured to keep vtest's 10 frames/s live (2026-11-26: top-down runs at 4-5
+// frames/s under the shared machine's load, topdown-flow at about twice that but finds fewer
+// people correctly). Each is a one-line change.
 inline constexpr std::string_view kFileDetector = "topdown";
 inline constexpr std::string_view kLiveDetector = "multipose";
 

@@ -549,10 +549,12 @@ int reconstruct_command(int argc, char** argv) {
   if (kind == InputKind::video) {
     // The default graph carries the file default; --graph keeps its own unless asked.
     const std::string detector = args.get("detector");
-    if (detector != "auto")
-      choose_detector(spec, detector);
-    else if (info.live && !args.has("graph"))
-      choose_detector(spec, std::string(kLiveDetector));
+    if (detector != "auto") choose_detector(spec, detector);
+    if (info.live && !args.has("graph")) {
+      if (detector == "auto") choose_detector(spec, std::string(kLiveDetector));
+      // Live: each frame decided as it comes; a look-ahead would cost lag x the detector's period.
+      set_param(spec, "recon.temporal_selector", "lag", "0");
+    }
   }
   configure(spec, args, out, kind);
   if (kind == InputKind::video) configure_video(spec, args, info);
