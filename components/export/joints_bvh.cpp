@@ -16,11 +16,11 @@ namespace {
 // The humanoid's bones in depth-first order (BVH channel order follows the hierarchy), each with
 // the end site after its chain's last bone: -1 marks an end site of the bone before it.
 constexpr std::array<int, kHumanBones + 5> kOrder = {
-    0, 1, 2, 3, 4, -1,      // Hips, Spine, Chest, Neck, Head, head top
-    5, 6, 7, 8, -1,         // left arm
-    9, 10, 11, 12, -1,      // right arm
-    13, 14, 15, -1,         // left leg
-    16, 17, 18, -1};        // right leg
+    0,  1,  2,  3,  4,  -1,  // Hips, Spine, Chest, Neck, Head, head top
+    5,  6,  7,  8,  -1,      // left arm
+    9,  10, 11, 12, -1,      // right arm
+    13, 14, 15, -1,          // left leg
+    16, 17, 18, -1};         // right leg
 
 HumanoidPose our_axes(const HumanoidPose& unity) {
   HumanoidPose pose = unity;  // to_unity mirrors X: applied twice it is the identity
@@ -54,8 +54,7 @@ motion::Skeleton humanoid_skeleton(const HumanoidPose& rest) {
       joint.offset = bone == 0 ? glm::vec3(0.0f) : rest.position[bone];
       if (!std::isfinite(joint.offset.x + joint.offset.y + joint.offset.z))
         joint.offset = glm::vec3(0.0f);
-      if (bone == 0)
-        joint.channels = {Channel::Xposition, Channel::Yposition, Channel::Zposition};
+      if (bone == 0) joint.channels = {Channel::Xposition, Channel::Yposition, Channel::Zposition};
       joint.channels.insert(joint.channels.end(),
                             {Channel::Zrotation, Channel::Xrotation, Channel::Yrotation});
       joint_of[bone] = static_cast<int>(skeleton.joints.size());

@@ -170,8 +170,7 @@ void RigReconstruction::emit(const FrameResult& result, People3D& out) {
       root = n > 0 ? sum / static_cast<float>(n) : glm::vec3(0.0f);
     }
     for (int j = 0; j < kBodyJoints; ++j) {
-      person.positions[j] = body[j].valid() ? body[j].position - root
-                                            : glm::vec3(std::nanf(""));
+      person.positions[j] = body[j].valid() ? body[j].position - root : glm::vec3(std::nanf(""));
     }
     person.root.translation = root;
     person.placed = true;

@@ -433,7 +433,6 @@ json node_latency(const graph::GraphStats& stats) {
   return nodes;
 }
 
-
 int reconstruct_command(int argc, char** argv) {
   if (asks_for_multiview(argc, argv)) return reconstruct_multiview_command(argc, argv);
   Args args(

@@ -60,7 +60,8 @@ ViewKind view_kind(const std::string& path) {
       images = images || video::is_image_file_name(name);
     }
     if (images) return ViewKind::video;
-    throw InputError(path, "neither OpenPose JSON files (*.json) nor images (.png, .jpg, ...) here");
+    throw InputError(path,
+                     "neither OpenPose JSON files (*.json) nor images (.png, .jpg, ...) here");
   }
   if (video::classify(path) == video::SourceKind::file && !fs::exists(path, ec))
     throw InputError(path, "no such file or folder");
@@ -126,10 +127,10 @@ std::vector<View> match_views(const camera::Rig& rig, const std::vector<std::str
                          " views were given; give one view per camera, in the rig's order");
   }
   if (paths.size() > rig.cameras.size()) {
-    throw InputError(paths[rig.cameras.size()],
-                     "no camera for this view: " + rig_file + " has " +
-                         std::to_string(rig.cameras.size()) + " cameras, " +
-                         std::to_string(paths.size()) + " views were given");
+    throw InputError(paths[rig.cameras.size()], "no camera for this view: " + rig_file + " has " +
+                                                    std::to_string(rig.cameras.size()) +
+                                                    " cameras, " + std::to_string(paths.size()) +
+                                                    " views were given");
   }
   std::vector<View> views;
   for (std::size_t i = 0; i < paths.size(); ++i)
@@ -194,7 +195,8 @@ int reconstruct_multiview_command(int argc, char** argv) {
       "mocap reconstruct --calibration RIG VIEW1 VIEW2 ... --out DIR [--fps F] [--force]",
       "Reconstructs every person seen by several calibrated cameras, in the rig's world. Each\n"
       "VIEW is a folder of OpenPose JSON, a video file or a folder of images (people found by the\n"
-      "detector), one per camera of RIG, in the rig's order. Writes into DIR: poses.jsonl (one line\n"
+      "detector), one per camera of RIG, in the rig's order. Writes into DIR: poses.jsonl (one "
+      "line\n"
       "per frame set: per person the track id and the 15 joints, metres, under joints_world in\n"
       "the rig's world), person_<id>.bvh per person (a humanoid skeleton with the person's bone\n"
       "lengths, y up, the floor at y = 0: the rig's floor, else the plane through its origin\n"

@@ -65,7 +65,8 @@ class MultiViewReconstructNode : public Node {
     out.header.stream = ctx.node_name();
     solver_->solve(views_, header->frame, out);
     ctx.send("out", std::move(out));
-    if (solver_->counts().sets % 30 == 1) ctx.report_status(solver_->counts().describe(solver_->rig()));
+    if (solver_->counts().sets % 30 == 1)
+      ctx.report_status(solver_->counts().describe(solver_->rig()));
   }
 
   void close(Context& ctx) override {
