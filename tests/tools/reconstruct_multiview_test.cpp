@@ -41,6 +41,13 @@ const std::map<std::string, std::string> kMarkers = {
     {"right_knee", "RKnee"},   {"right_ankle", "RAnkle"}, {"left_hip", "LHip"},
     {"left_knee", "LKnee"},    {"left_ankle", "LAnkle"}};
 
+// Humanoid joints of the BVH (export/humanoid.hpp) at body joints.
+const std::map<std::string, std::string> kLimbJoints = {
+    {"LeftLowerArm", "left_elbow"},   {"LeftHand", "left_wrist"},
+    {"RightLowerArm", "right_elbow"}, {"RightHand", "right_wrist"},
+    {"LeftLowerLeg", "left_knee"},    {"LeftFoot", "left_ankle"},
+    {"RightLowerLeg", "right_knee"},  {"RightFoot", "right_ankle"}};
+
 class ReconstructMultiView : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -104,6 +111,7 @@ TEST_F(ReconstructMultiView, Pose2SimDemoAgreesWithItsTrcAndTheBvhStandsOnTheFlo
   std::vector<float> distances;
   int participant = -1;
   std::vector<glm::vec3> roots;  // the participant's, per frame
+  std::vector<json> bodies;      // the participant's joints_world, per frame
   for (int f = 0; f < kFrames; ++f) {
     const json& line = frames[static_cast<std::size_t>(f)];
     EXPECT_EQ(line["frame"], f);
@@ -118,6 +126,7 @@ TEST_F(ReconstructMultiView, Pose2SimDemoAgreesWithItsTrcAndTheBvhStandsOnTheFlo
       if (participant < 0) participant = person["id"];
       EXPECT_EQ(person["id"], participant) << "frame " << f;
       roots.push_back(vec(w["root"]));
+      bodies.push_back(w);
       for (const auto& [joint, marker] : kMarkers) {
         if (w[joint][0].is_null()) continue;
         distances.push_back(glm::distance(vec(w[joint]), markers[*trc.marker(marker)]));
@@ -151,6 +160,16 @@ TEST_F(ReconstructMultiView, Pose2SimDemoAgreesWithItsTrcAndTheBvhStandsOnTheFlo
     EXPECT_NEAR(global.position[0].y, root.z, 1e-3);
     EXPECT_NEAR(global.position[0].z, -root.y, 1e-3);
     for (const glm::vec3& p : global.position) lowest = std::min(lowest, p.y);
+    // The limbs point where the joints are: the file's joints within the bone lengths' change
+    // since the first frame (a wrong rotation puts a hand or foot decimetres off).
+    for (const auto& [bone, joint] : kLimbJoints) {
+      const json& w = bodies[static_cast<std::size_t>(f)][joint];
+      if (w[0].is_null()) continue;
+      const glm::vec3 world = vec(w);
+      const glm::vec3 at = global.position[static_cast<std::size_t>(clip.skeleton.find(bone))];
+      EXPECT_LT(glm::distance(at, glm::vec3(world.x, world.z, -world.y)), 0.08f)
+          << bone << " at frame " << f;
+    }
   }
   EXPECT_GT(lowest, -0.05f) << "the feet go under the floor";
   EXPECT_LT(lowest, 0.15f) << "the feet float above the floor";

@@ -451,7 +451,9 @@ int reconstruct_command(int argc, char** argv) {
       "has\n"
       "written its output, put back as they were when it wrote none (it failed at the start).\n"
       "Files are written as the run goes and stay whole, so an interrupted run (Ctrl-C, a kill)\n"
-      "keeps what it wrote under the files' own names; summary.json is written at the end.");
+      "keeps what it wrote under the files' own names; summary.json is written at the end.\n\n"
+      "Several calibrated cameras: mocap reconstruct --calibration RIG VIEW1 VIEW2 ... --out DIR\n"
+      "(see mocap reconstruct --calibration RIG --help).");
   args.positional("INPUT",
                   "video file, /dev/videoN, rtsp:// or http:// URL, image folder, or "
                   "folder of OpenPose *_keypoints.json files")
