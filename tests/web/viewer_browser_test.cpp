@@ -187,23 +187,30 @@ void write_recording(const std::string& path) {
   write_file(path, text);
 }
 
-TEST(ViewerBrowser, MocapViewPlaysARecordingInChromium) {
-  MOCAP_REQUIRE_BROWSER(browser);
-  TempDir dir;
-  write_recording(dir.file("poses.jsonl"));
+// `mocap view ARGS --port P` started and serving (it printed its URL, or 20 s passed); `url` set.
+std::unique_ptr<Mocap> start_view(const TempDir& dir, std::vector<std::string> args,
+                                  std::string& url) {
   const int port = free_tcp_port();
   std::vector<std::string> env;  // Mocap drops MOCAP_* variables; the npm cache's stays
   if (const char* npm = std::getenv("MOCAP_NPM_DIR"))
     env.push_back(std::string("MOCAP_NPM_DIR=") + npm);
-  Mocap view(
-      dir, "view",
-      {"view", dir.file("poses.jsonl"), "--port", std::to_string(port), "--image-size", "640x480"},
-      env);
-  const std::string url = "http://127.0.0.1:" + std::to_string(port) + "/";
+  args.insert(args.begin(), "view");
+  args.insert(args.end(), {"--port", std::to_string(port)});
+  auto view = std::make_unique<Mocap>(dir, "view", args, env);
+  url = "http://127.0.0.1:" + std::to_string(port) + "/";
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
-  while (view.out().find(url) == std::string::npos && std::chrono::steady_clock::now() < deadline)
+  while (view->out().find(url) == std::string::npos && std::chrono::steady_clock::now() < deadline)
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  ASSERT_NE(view.out().find("120 frames"), std::string::npos) << view.out() << view.err();
+  return view;
+}
+
+TEST(ViewerBrowser, MocapViewPlaysARecordingInChromium) {
+  MOCAP_REQUIRE_BROWSER(browser);
+  TempDir dir;
+  write_recording(dir.file("poses.jsonl"));
+  std::string url;
+  const auto view = start_view(dir, {dir.file("poses.jsonl"), "--image-size", "640x480"}, url);
+  ASSERT_NE(view->out().find("120 frames"), std::string::npos) << view->out() << view->err();
   const Json result = drive_page(browser, dir, url + "?aa=0",
                                  {"--frames", "30", "--people", "3", "--timeline", "--screenshot",
                                   artefact("viewer_recording.png").string()});
@@ -218,19 +225,9 @@ TEST(ViewerBrowser, MocapViewShowsAWorldRecordingWithItsRigsCameras) {
   MOCAP_REQUIRE_BROWSER(browser);
   TempDir dir;
   write_world_recording(dir.file("poses.jsonl"), dir.file("rig.toml"));
-  const int port = free_tcp_port();
-  std::vector<std::string> env;
-  if (const char* npm = std::getenv("MOCAP_NPM_DIR"))
-    env.push_back(std::string("MOCAP_NPM_DIR=") + npm);
-  Mocap view(dir, "view",
-             {"view", dir.file("poses.jsonl"), "--port", std::to_string(port), "--rig",
-              dir.file("rig.toml")},
-             env);
-  const std::string url = "http://127.0.0.1:" + std::to_string(port) + "/";
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
-  while (view.out().find(url) == std::string::npos && std::chrono::steady_clock::now() < deadline)
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  ASSERT_NE(view.out().find("60 frames"), std::string::npos) << view.out() << view.err();
+  std::string url;
+  const auto view = start_view(dir, {dir.file("poses.jsonl"), "--rig", dir.file("rig.toml")}, url);
+  ASSERT_NE(view->out().find("60 frames"), std::string::npos) << view->out() << view->err();
   const Json result = drive_page(browser, dir, url + "?aa=0",
                                  {"--frames", "20", "--people", "2", "--cameras", "4",
                                   "--screenshot", artefact("viewer_world.png").string()});
