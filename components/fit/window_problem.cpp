@@ -53,14 +53,14 @@ struct ReprojectionCost {
   const FrameData* data;
   Chain chain;
   double u, v, weight;
-  recon::Pinhole camera;
   template <typename T>
   bool operator()(T const* const* p, T* r) const {
     T x[3];
     chain_position(p[0], p[1], p + 2, chain, *data, x);
     if (x[2] < T(1e-3)) x[2] = T(1e-3);  // behind the camera: keep finite
-    r[0] = (T(camera.fx) * x[0] / x[2] + T(camera.cx) - T(u)) * T(weight);
-    r[1] = (T(camera.fy) * x[1] / x[2] + T(camera.cy) - T(v)) * T(weight);
+    const auto& k = data->pinhole;
+    r[0] = (T(k[0]) * x[0] / x[2] + T(k[2]) - T(u)) * T(weight);
+    r[1] = (T(k[1]) * x[1] / x[2] + T(k[3]) - T(v)) * T(weight);
     return true;
   }
 };
@@ -309,9 +309,9 @@ WindowSummary solve_window(std::span<const WindowFrame> frames, Bones& bones,
         const double c = d.keypoints[3 * j + 2];
         if (!(c >= wt.min_confidence)) continue;
         auto cost = std::make_unique<Dynamic<ReprojectionCost>>(
-            std::make_unique<ReprojectionCost>(
-                ReprojectionCost{&d, chains[j], d.keypoints[3 * j], d.keypoints[3 * j + 1],
-                                 std::sqrt(c) / d.sigma_px, options.camera})
+            std::make_unique<ReprojectionCost>(ReprojectionCost{&d, chains[j], d.keypoints[3 * j],
+                                                                d.keypoints[3 * j + 1],
+                                                                std::sqrt(c) / d.sigma_px})
                 .release());
         std::vector<double*> blocks = {v.t.data(), bones.data()};
         cost->AddParameterBlock(3);

@@ -34,7 +34,8 @@ struct FrameData {
   bool observed = false;                           // retrieved pose and keypoints present
   std::array<std::array<double, 3>, kBones> d0{};  // reference bone directions (unit, camera)
   recon::BodyXyc keypoints{};
-  double sigma_px = 0.0;  // one reprojection sigma in pixels (0: no reprojection term)
+  double sigma_px = 0.0;            // one reprojection sigma in pixels (0: no reprojection term)
+  std::array<double, 4> pinhole{};  // fx, fy, cx, cy of the camera that saw the keypoints
   std::array<bool, 2> contact{};
   bool has_start = false;           // the closed-form translation exists
   std::array<double, 3> start_t{};  // closed-form root translation (camera frame)
