@@ -10,15 +10,15 @@
 
 namespace mocap::fit {
 
-std::vector<CameraPose> camera_poses(std::span<const eval::Body> world,
-                                     std::span<const eval::Body> camera) {
-  std::vector<CameraPose> out(std::min(world.size(), camera.size()));
+std::vector<camera::Camera> moving_cameras(const camera::Camera& lens,
+                                           std::span<const eval::Body> world,
+                                           std::span<const eval::Body> camera) {
+  std::vector<camera::Camera> out(std::min(world.size(), camera.size()), lens);
   for (std::size_t t = 0; t < out.size(); ++t) {
     std::array<glm::dvec3, kBodyJoints> from, to;
     for (int j = 0; j < kBodyJoints; ++j) from[j] = camera[t][j], to[j] = world[t][j];
     const eval::Similarity s = eval::procrustes(from, to, eval::Alignment::rigid);
-    out[t].rotation = glm::quat_cast(s.rotation);
-    out[t].position = s.translation;
+    out[t].set_pose_from_centre(s.rotation, s.translation);
   }
   return out;
 }
@@ -26,7 +26,7 @@ std::vector<CameraPose> camera_poses(std::span<const eval::Body> world,
 std::vector<FrameInput> make_inputs(std::span<const recon::BodyXyc> keypoints,
                                     std::span<const recon::Pose3D> retrieved,
                                     std::span<const std::array<bool, 2>> contacts,
-                                    std::span<const CameraPose> cameras) {
+                                    std::span<const camera::Camera> cameras) {
   std::vector<FrameInput> out(keypoints.size());
   for (std::size_t t = 0; t < out.size(); ++t) {
     out[t].keypoints = keypoints[t];
@@ -35,7 +35,7 @@ std::vector<FrameInput> make_inputs(std::span<const recon::BodyXyc> keypoints,
       out[t].retrieved = retrieved[t].joints;
     }
     if (t < contacts.size()) out[t].contact = contacts[t];
-    if (t < cameras.size()) out[t].camera = cameras[t];
+    if (t < cameras.size()) out[t].moving_camera = cameras[t];
   }
   return out;
 }
@@ -75,12 +75,12 @@ void PlacementScores::add(const PlacementScores& o) {
 
 PlacementScores score_placement(std::span<const FittedFrame> fitted,
                                 std::span<const eval::Body> truth_camera,
-                                std::span<const CameraPose> cameras,
+                                std::span<const camera::Camera> cameras,
                                 std::span<const std::array<bool, 2>> contacts, double floor_y) {
   PlacementScores s;
   const std::size_t n = std::min({fitted.size(), truth_camera.size(), cameras.size()});
   auto world = [&](std::size_t t, int joint) {
-    return cameras[t].rotation * glm::dvec3(fitted[t].joints[joint]) + cameras[t].position;
+    return cameras[t].to_world(glm::dvec3(fitted[t].joints[joint]));
   };
   for (std::size_t t = 0; t < n; ++t) {
     if (!fitted[t].valid) continue;

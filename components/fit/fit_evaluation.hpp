@@ -14,16 +14,19 @@
 
 namespace mocap::fit {
 
-// The camera -> world pose of every frame, from the same joints in both frames (the protocol's
-// cameras follow the person, so each frame has its own pose). Rigid Procrustes over the joints.
-std::vector<CameraPose> camera_poses(std::span<const eval::Body> world,
-                                     std::span<const eval::Body> camera);
+// The camera of every frame: `lens`'s intrinsics placed in the world by the same joints in both
+// frames (the protocol's cameras follow the person, so each frame has its own pose). Rigid
+// Procrustes over the joints.
+std::vector<camera::Camera> moving_cameras(const camera::Camera& lens,
+                                           std::span<const eval::Body> world,
+                                           std::span<const eval::Body> camera);
 
-// One FrameInput per frame: keypoints, the retrieved pose where valid, contacts, camera pose.
+// One FrameInput per frame: keypoints, the retrieved pose where valid, contacts, the frame's
+// moving camera (none: the fit's static camera).
 std::vector<FrameInput> make_inputs(std::span<const recon::BodyXyc> keypoints,
                                     std::span<const recon::Pose3D> retrieved,
                                     std::span<const std::array<bool, 2>> contacts,
-                                    std::span<const CameraPose> cameras);
+                                    std::span<const camera::Camera> cameras);
 
 // Contact of the truth's ankles (world, y up): slower than max_speed_mps and within max_height_m
 // of the clip's lowest ankle.
@@ -52,7 +55,7 @@ struct PlacementScores {
 // Scores absolute joints (camera frame; invalid frames skipped) against the truth.
 PlacementScores score_placement(std::span<const FittedFrame> fitted,
                                 std::span<const eval::Body> truth_camera,
-                                std::span<const CameraPose> cameras,
+                                std::span<const camera::Camera> cameras,
                                 std::span<const std::array<bool, 2>> contacts, double floor_y);
 
 // Fitted frames as the protocol's Pose3D (root-relative joints), for eval::score.

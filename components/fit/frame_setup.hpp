@@ -20,6 +20,9 @@ bool usable(const BoneLengths& b);  // every bone positive and finite
 // The frame has a retrieved pose (finite): it is observed.
 bool observed(const FrameInput& in);
 
+// The camera that saw the frame: its moving camera, else the options' static one.
+const camera::Camera& camera_of(const FrameInput& in, const FitOptions& options);
+
 // The constants of a frame; `reference` supplies the bone directions when the frame has no
 // retrieved pose of its own.
 FrameData frame_data(const FrameInput& in, const Body& reference, const FitOptions& options);

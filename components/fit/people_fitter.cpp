@@ -22,10 +22,6 @@ void add(FitStats& total, const FitStats& s) {
   total.final_cost += s.final_cost;
 }
 
-mocap::GroundPlane to_message(const GroundPlane& p) {
-  return {glm::vec3(p.normal), static_cast<float>(p.offset)};
-}
-
 }  // namespace
 
 struct PeopleFitter::State {
@@ -165,7 +161,7 @@ struct PeopleFitter::State {
   }
 
   People3D finished(People3D frame) const {
-    if (ground) frame.has_ground = true, frame.ground = to_message(*ground);
+    if (ground) frame.has_ground = true, frame.ground = *ground;
     return frame;
   }
 
@@ -296,10 +292,7 @@ std::size_t PeopleFitter::held_frames() const {
   return state_->held.size() + state_->warm_up.size();
 }
 const FitStats& PeopleFitter::stats() const { return state_->stats; }
-std::optional<mocap::GroundPlane> PeopleFitter::ground() const {
-  if (!state_->ground) return std::nullopt;
-  return to_message(*state_->ground);
-}
+std::optional<mocap::GroundPlane> PeopleFitter::ground() const { return state_->ground; }
 const std::string& PeopleFitter::ground_source() const { return state_->ground_source; }
 
 std::string PeopleFitter::summary() const {

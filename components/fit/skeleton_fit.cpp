@@ -47,8 +47,8 @@ BoneLengths median_bone_lengths(std::span<const Body> poses) {
 }
 
 std::optional<glm::dvec3> initial_translation(const Body& pose, const recon::BodyXyc& keypoints,
-                                              const recon::Pinhole& camera, double min_confidence) {
-  if (!camera.valid()) return std::nullopt;
+                                              const camera::Camera& camera, double min_confidence) {
+  if (!camera.has_intrinsics()) return std::nullopt;
   // Each present joint: tx - u' tz = u' Z - X and ty - v' tz = v' Z - Y.
   glm::dmat3 ata(0.0);
   glm::dvec3 atb(0.0);
@@ -140,6 +140,10 @@ bool usable(const BoneLengths& b) {
 
 bool observed(const FrameInput& in) { return in.retrieved_valid && finite_body(in.retrieved); }
 
+const camera::Camera& camera_of(const FrameInput& in, const FitOptions& options) {
+  return in.moving_camera ? *in.moving_camera : options.camera;
+}
+
 FrameData frame_data(const FrameInput& in, const Body& reference, const FitOptions& options) {
   FrameData d;
   d.observed = observed(in);
@@ -156,10 +160,13 @@ FrameData frame_data(const FrameInput& in, const Body& reference, const FitOptio
     d.sigma_px = size > 1.0 ? options.weights.reprojection * size : 0.0;
     d.contact = in.contact;
   }
-  const glm::dmat3 r = glm::mat3_cast(in.camera.rotation);
+  const camera::Camera& camera = camera_of(in, options);
+  d.pinhole = {camera.fx, camera.fy, camera.cx, camera.cy};
+  // camera -> world is the transpose of the camera's world -> camera rotation.
   for (int row = 0; row < 3; ++row)
-    for (int col = 0; col < 3; ++col) d.rotation[3 * row + col] = r[col][row];
-  d.position = {in.camera.position.x, in.camera.position.y, in.camera.position.z};
+    for (int col = 0; col < 3; ++col) d.rotation[3 * row + col] = camera.rotation[row][col];
+  const glm::dvec3 centre = camera.centre();
+  d.position = {centre.x, centre.y, centre.z};
   return d;
 }
 
@@ -183,8 +190,8 @@ std::optional<glm::dvec3> start_translation(const FrameInput& in, const BoneLeng
                                             const FitOptions& options) {
   Body pose = with_bone_lengths(in.retrieved, bones);
   for (auto& p : pose) p -= in.retrieved[index(Joint::root)];
-  const auto t =
-      initial_translation(pose, in.keypoints, options.camera, options.weights.min_confidence);
+  const auto t = initial_translation(pose, in.keypoints, camera_of(in, options),
+                                     options.weights.min_confidence);
   if (t && t->z > 0.1) return t;
   return std::nullopt;
 }

@@ -23,8 +23,9 @@
 #include <glm/gtc/quaternion.hpp>
 #include <glm/vec3.hpp>
 
+#include "camera/camera.hpp"
 #include "core/body15.hpp"
-#include "recon/ray_alignment.hpp"
+#include "core/ground_plane.hpp"
 #include "recon/sequence_reconstruction.hpp"
 
 namespace mocap::fit {
@@ -40,19 +41,6 @@ struct BoneLengths {
 BoneLengths bone_lengths_of(const Body& pose);
 BoneLengths median_bone_lengths(std::span<const Body> poses);
 
-// Where the camera is in the world at one frame (camera -> world: x_w = rotation · x_c + position).
-// The default is a static camera whose frame is the world.
-struct CameraPose {
-  glm::dquat rotation{1.0, 0.0, 0.0, 0.0};
-  glm::dvec3 position{0.0};
-};
-
-// The ground in the world: points x with dot(normal, x) + offset = 0, normal pointing up.
-struct GroundPlane {
-  glm::dvec3 normal{0.0, -1.0, 0.0};  // camera convention: y down
-  double offset = 0.0;
-};
-
 // Feet of the 15-joint body (the ankles) in the order contact flags use them.
 inline constexpr std::array<int, 2> kFeet = {index(Joint::right_ankle), index(Joint::left_ankle)};
 
@@ -64,7 +52,10 @@ struct FrameInput {
   bool retrieved_valid = false;
   Body retrieved{};
   std::array<bool, 2> contact{};  // right, left ankle in contact with the ground (kFeet order)
-  CameraPose camera;
+  // The camera of this frame when it moves (the virtual protocol's cameras follow the person):
+  // its intrinsics and its pose in the world of FitOptions::ground. Absent (the usual static
+  // camera, no copy per frame): FitOptions::camera.
+  std::optional<camera::Camera> moving_camera;
 };
 
 // Standard deviations: each residual is (value / sigma), so a residual of 1 is "one sigma off".
@@ -89,7 +80,10 @@ struct FitWeights {
 };
 
 struct FitOptions {
-  recon::Pinhole camera;              // intrinsics (required)
+  // The camera (intrinsics required) and its pose in the world that `ground` is in; the default
+  // pose (identity) makes the camera's frame the world. Only its pinhole is used: keypoints are
+  // given undistorted (camera::Camera::undistort_pixels), so the fit never distorts.
+  camera::Camera camera;
   std::optional<GroundPlane> ground;  // in the world frame; no penetration term without it
   double ankle_clearance_m = 0.07;    // the ankle joint's height over the sole
   std::optional<BoneLengths> bones;   // initial lengths; the retrieved poses' medians if absent
@@ -131,7 +125,7 @@ struct FitResult {
 // (X_j + t) × ray_j = 0 for every present keypoint, weighted by confidence. nullopt with fewer
 // than two present keypoints or a degenerate system.
 std::optional<glm::dvec3> initial_translation(const Body& pose, const recon::BodyXyc& keypoints,
-                                              const recon::Pinhole& camera,
+                                              const camera::Camera& camera,
                                               double min_confidence = 0.05);
 
 // `retrieved` rebuilt with `bones`: every bone keeps its direction and gets its length.

@@ -5,7 +5,7 @@
 namespace mocap::fit {
 
 std::vector<FittedFrame> placed_retrieval(std::span<const FrameInput> inputs,
-                                          const recon::Pinhole& camera) {
+                                          const camera::Camera& camera) {
   std::vector<FittedFrame> out(inputs.size());
   for (std::size_t t = 0; t < inputs.size(); ++t) {
     if (!inputs[t].retrieved_valid) continue;
@@ -21,14 +21,13 @@ std::vector<FittedFrame> placed_retrieval(std::span<const FrameInput> inputs,
 
 ViewFits reconstruct_and_fit(recon::Matcher& matcher, const recon::FrameBones& bones,
                              const ContactDetector* contacts, std::span<const recon::BodyXyc> input,
-                             const CameraPose& camera, const recon::SequenceOptions& retrieval,
-                             const FitOptions& options, ViewFitRequest request) {
+                             const recon::SequenceOptions& retrieval, const FitOptions& options,
+                             ViewFitRequest request) {
   ViewFits out;
   out.retrieved = recon::reconstruct_sequence(matcher, bones, input, retrieval);
-  const std::vector<CameraPose> cameras(input.size(), camera);
   const auto inputs = make_inputs(
       input, out.retrieved,
-      contacts ? contacts->contacts(out.retrieved) : std::vector<std::array<bool, 2>>{}, cameras);
+      contacts ? contacts->contacts(out.retrieved) : std::vector<std::array<bool, 2>>{}, {});
   out.placed = placed_retrieval(inputs, options.camera);
   if (request.full) out.full = fit_sequence(inputs, options).frames;
   if (request.live) {

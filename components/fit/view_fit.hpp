@@ -16,7 +16,7 @@ namespace mocap::fit {
 // The retrieval's poses placed by the closed-form translation (initial_translation): frames
 // without a retrieved pose or a translation are invalid.
 std::vector<FittedFrame> placed_retrieval(std::span<const FrameInput> inputs,
-                                          const recon::Pinhole& camera);
+                                          const camera::Camera& camera);
 
 struct ViewFitRequest {
   bool full = true;  // fit_sequence
@@ -30,11 +30,11 @@ struct ViewFits {
 };
 
 // Reconstructs `input` (one person's keypoints per frame) with `retrieval` (its camera should be
-// `options.camera` for the ray alignment) and fits it; every frame carries `camera` (camera ->
-// world), so `options.ground` is in that world. Contacts come from `contacts` when given.
+// `options.camera` for the ray alignment) and fits it with `options.camera` (static, placed in
+// the world of `options.ground`). Contacts come from `contacts` when given.
 ViewFits reconstruct_and_fit(recon::Matcher& matcher, const recon::FrameBones& bones,
                              const ContactDetector* contacts, std::span<const recon::BodyXyc> input,
-                             const CameraPose& camera, const recon::SequenceOptions& retrieval,
-                             const FitOptions& options, ViewFitRequest request = {});
+                             const recon::SequenceOptions& retrieval, const FitOptions& options,
+                             ViewFitRequest request = {});
 
 }  // namespace mocap::fit

@@ -53,14 +53,36 @@ struct ReprojectionCost {
   const FrameData* data;
   Chain chain;
   double u, v, weight;
-  recon::Pinhole camera;
   template <typename T>
   bool operator()(T const* const* p, T* r) const {
     T x[3];
     chain_position(p[0], p[1], p + 2, chain, *data, x);
     if (x[2] < T(1e-3)) x[2] = T(1e-3);  // behind the camera: keep finite
-    r[0] = (T(camera.fx) * x[0] / x[2] + T(camera.cx) - T(u)) * T(weight);
-    r[1] = (T(camera.fy) * x[1] / x[2] + T(camera.cy) - T(v)) * T(weight);
+    const auto& k = data->pinhole;
+    r[0] = (T(k[0]) * x[0] / x[2] + T(k[2]) - T(u)) * T(weight);
+    r[1] = (T(k[1]) * x[1] / x[2] + T(k[3]) - T(v)) * T(weight);
+    return true;
+  }
+};
+
+// The same through a calibrated view: the joint is moved into the view's camera first.
+struct ViewReprojectionCost {
+  const FrameData* data;
+  const ViewData* view;
+  Chain chain;
+  double u, v, weight;
+  template <typename T>
+  bool operator()(T const* const* p, T* r) const {
+    T x[3], c[3];
+    chain_position(p[0], p[1], p + 2, chain, *data, x);
+    const auto& m = view->rotation;
+    for (int row = 0; row < 3; ++row)
+      c[row] = T(m[3 * row]) * x[0] + T(m[3 * row + 1]) * x[1] + T(m[3 * row + 2]) * x[2] +
+               T(view->translation[row]);
+    if (c[2] < T(1e-3)) c[2] = T(1e-3);  // behind the camera: keep finite
+    const auto& k = view->pinhole;
+    r[0] = (T(k[0]) * c[0] / c[2] + T(k[2]) - T(u)) * T(weight);
+    r[1] = (T(k[1]) * c[1] / c[2] + T(k[3]) - T(v)) * T(weight);
     return true;
   }
 };
@@ -309,9 +331,9 @@ WindowSummary solve_window(std::span<const WindowFrame> frames, Bones& bones,
         const double c = d.keypoints[3 * j + 2];
         if (!(c >= wt.min_confidence)) continue;
         auto cost = std::make_unique<Dynamic<ReprojectionCost>>(
-            std::make_unique<ReprojectionCost>(
-                ReprojectionCost{&d, chains[j], d.keypoints[3 * j], d.keypoints[3 * j + 1],
-                                 std::sqrt(c) / d.sigma_px, options.camera})
+            std::make_unique<ReprojectionCost>(ReprojectionCost{&d, chains[j], d.keypoints[3 * j],
+                                                                d.keypoints[3 * j + 1],
+                                                                std::sqrt(c) / d.sigma_px})
                 .release());
         std::vector<double*> blocks = {v.t.data(), bones.data()};
         cost->AddParameterBlock(3);
@@ -324,6 +346,29 @@ WindowSummary solve_window(std::span<const WindowFrame> frames, Bones& bones,
         problem.AddResidualBlock(cost.release(), robust.get(), blocks);
       }
     }
+    // Reprojection in every calibrated view (multi-view).
+    if (d.observed)
+      for (const ViewData& view : d.views) {
+        if (!(view.sigma_px > 0.0)) continue;
+        for (int j = 0; j < kBodyJoints; ++j) {
+          const double c = view.keypoints[3 * j + 2];
+          if (!(c >= wt.min_confidence)) continue;
+          auto cost = std::make_unique<Dynamic<ViewReprojectionCost>>(
+              std::make_unique<ViewReprojectionCost>(
+                  ViewReprojectionCost{&d, &view, chains[j], view.keypoints[3 * j],
+                                       view.keypoints[3 * j + 1], std::sqrt(c) / view.sigma_px})
+                  .release());
+          std::vector<double*> blocks = {v.t.data(), bones.data()};
+          cost->AddParameterBlock(3);
+          cost->AddParameterBlock(kBones);
+          for (int k = 0; k < chains[j].length; ++k) {
+            cost->AddParameterBlock(3);
+            blocks.push_back(v.w[chains[j].bone[k]].data());
+          }
+          cost->SetNumResiduals(2);
+          problem.AddResidualBlock(cost.release(), robust.get(), blocks);
+        }
+      }
     // Weak prior towards the closed-form translation (depth is weakly observed in 2D).
     if (d.observed && d.has_start)
       problem.AddResidualBlock(std::make_unique<ceres::AutoDiffCostFunction<TranslationCost, 3, 3>>(

@@ -5,6 +5,7 @@
 
 #include <array>
 #include <span>
+#include <vector>
 
 #include <glm/vec3.hpp>
 
@@ -29,17 +30,31 @@ struct FrameVars {
   std::array<std::array<double, 3>, kBones> w{};
 };
 
+// A calibrated view of a frame (multi-view fitting): its keypoints and the camera that saw them,
+// placed relative to the frame's variables (x_camera = rotation · x + translation).
+struct ViewData {
+  recon::BodyXyc keypoints{};       // undistorted pixels
+  double sigma_px = 0.0;            // one reprojection sigma in pixels (0: no term)
+  std::array<double, 4> pinhole{};  // fx, fy, cx, cy
+  std::array<double, 9> rotation{1, 0, 0, 0, 1, 0, 0, 0, 1};  // row-major
+  std::array<double, 3> translation{};
+};
+
 // A frame's constants.
 struct FrameData {
   bool observed = false;                           // retrieved pose and keypoints present
   std::array<std::array<double, 3>, kBones> d0{};  // reference bone directions (unit, camera)
   recon::BodyXyc keypoints{};
-  double sigma_px = 0.0;  // one reprojection sigma in pixels (0: no reprojection term)
+  double sigma_px = 0.0;            // one reprojection sigma in pixels (0: no reprojection term)
+  std::array<double, 4> pinhole{};  // fx, fy, cx, cy of the camera that saw the keypoints
   std::array<bool, 2> contact{};
   bool has_start = false;           // the closed-form translation exists
   std::array<double, 3> start_t{};  // closed-form root translation (camera frame)
   std::array<double, 9> rotation{1, 0, 0, 0, 1, 0, 0, 0, 1};  // camera -> world, row-major
   std::array<double, 3> position{};                           // camera centre in the world
+  // Multi-view: every camera that saw the person (the variables are then in the world and the
+  // single-camera keypoints above are unused: sigma_px 0). Empty for the monocular fit.
+  std::vector<ViewData> views;
 };
 
 using Bones = std::array<double, kBones>;

@@ -12,19 +12,6 @@
 
 namespace mocap::recon {
 
-// The intrinsics components/fit takes (in float). Only the fitting uses it while it is being
-// rewritten; everything else takes camera::Camera, and the fitting will too.
-struct Pinhole {
-  float fx = 0, fy = 0, cx = 0, cy = 0;  // pixels
-  bool valid() const { return fx > 0 && fy > 0; }
-  // A camera of `width` x `height` pixels and horizontal field of view `hfov_deg`, square pixels,
-  // principal point in the centre: the assumption when no calibration is given.
-  static Pinhole from_fov(int width, int height, float hfov_deg);
-};
-
-// The intrinsics of `camera` for the fitting.
-Pinhole pinhole_of(const camera::Camera& camera);
-
 // The rotation taking a pose expressed in a camera that looks at the root (x horizontal) into the
 // frame of `camera`, which sees the root at `root_pixel` (undistorted: the pinhole's pixel).
 // Assumes the camera has no roll (its x axis horizontal), as the database's cameras. Identity

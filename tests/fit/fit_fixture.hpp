@@ -30,20 +30,17 @@ inline const std::vector<eval::Body>& fit_clip_world() {
 
 #define MOCAP_REQUIRE_FIT_CLIP() MOCAP_REQUIRE_SHARED(::mocap::test::kFitClip)
 
-inline recon::Pinhole fit_camera() {
-  const eval::Image image;
-  return recon::Pinhole::from_fov(image.width, image.height, image.horizontal_fov_deg);
-}
-// The same camera for the retrieval (recon::SequenceOptions).
-inline camera::Camera fit_lens() {
+// The protocol's camera (the fit's and the retrieval's), at the world origin.
+inline camera::Camera fit_camera() {
   const eval::Image image;
   return camera::Camera::from_fov(image.width, image.height, image.horizontal_fov_deg);
 }
+inline camera::Camera fit_lens() { return fit_camera(); }
 
 struct FitScene {
   std::vector<eval::Body> world;
   eval::RenderedSequence rendered;
-  std::vector<fit::CameraPose> cameras;
+  std::vector<camera::Camera> cameras;  // each frame's (the camera follows the person)
 };
 
 // Frames [first, first + count) of the clip through a camera at `yaw_deg`, 1.5 m high, 4.5 m
@@ -56,7 +53,7 @@ inline FitScene fit_scene(std::size_t first, std::size_t count, float yaw_deg, f
                  all.begin() + static_cast<std::ptrdiff_t>(std::min(all.size(), first + count)));
   const eval::TruthSequence truth{"07_01", s.world};
   s.rendered = eval::render(truth, {"level", yaw_deg, 1.5f, 0.0f, 4.5f}, {}, {noise, 0.0f}, seed);
-  s.cameras = fit::camera_poses(s.world, s.rendered.truth_camera);
+  s.cameras = fit::moving_cameras(fit_camera(), s.world, s.rendered.truth_camera);
   return s;
 }
 

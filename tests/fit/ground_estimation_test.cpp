@@ -77,7 +77,7 @@ glm::dvec3 walk_centre() {
 // The median error of the heights over the estimated floor of the walk's ankles (in contact or
 // not) against their true heights: the plane where the people are. (The camera's own height
 // over the plane moves by its distance times the normal's error: 6 m x 1 degree = 10 cm.)
-double median_height_error_m(const fit::GroundPlane& plane, const StaticCamera& camera) {
+double median_height_error_m(const GroundPlane& plane, const StaticCamera& camera) {
   std::vector<double> errors;
   for (const auto& body : test::fit_clip_world()) {
     for (int a : fit::kFeet) {

@@ -48,7 +48,7 @@ fit::PeopleFitOptions full_options() {
   o.mode = fit::StreamFitMode::full;
   o.fit.camera = test::fit_camera();
   o.window = {16, 4};
-  o.calibrated_ground = fit::GroundPlane{{0.0, -1.0, 0.0}, 1.5};  // 1.5 m under the camera
+  o.calibrated_ground = GroundPlane{{0.0, -1.0, 0.0}, 1.5};  // 1.5 m under the camera
   return o;
 }
 

@@ -30,7 +30,7 @@ fit::FitOptions base_options() {
 }
 
 double reprojection_px(const std::vector<fit::FittedFrame>& fitted,
-                       const std::vector<recon::BodyXyc>& input, const recon::Pinhole& c) {
+                       const std::vector<recon::BodyXyc>& input, const camera::Camera& c) {
   double sum = 0;
   int n = 0;
   for (std::size_t t = 0; t < fitted.size(); ++t)
@@ -339,7 +339,7 @@ TEST(SkeletonFit, FreeSizeFollowsTheGroundAndTheContactFeet) {
   const auto contacts = fit::truth_contacts(s.world, test::kFitFps);
   const auto inputs = fit::make_inputs(s.rendered.input, retrieved, contacts, s.cameras);
   auto options = base_options();
-  options.ground = fit::GroundPlane{{0.0, 1.0, 0.0}, 0.0};
+  options.ground = GroundPlane{{0.0, 1.0, 0.0}, 0.0};
   options.ankle_clearance_m = fit::ankle_floor(s.world);
   const double truth = bone_sum(truth_bones(s.world));
   const auto kept = fit::fit_sequence(inputs, options);

@@ -25,13 +25,8 @@ constexpr glm::dvec3 kUp{0.0, 0.0, 1.0};
 struct View {
   std::vector<recon::BodyXyc> input;
   std::vector<eval::Body> truth_camera;
-  camera::Camera intrinsics;  // the retrieval's camera; the fit takes its pinhole
-  CameraPose camera;
+  camera::Camera camera;  // calibrated: the retrieval's and the fit's, placed in the world
 };
-
-CameraPose pose_of(const camera::Camera& c) {
-  return {glm::quat_cast(glm::transpose(c.rotation)), c.centre()};
-}
 
 struct Outcome {
   std::vector<ViewFits> fits;
@@ -50,17 +45,17 @@ Outcome run(const posedb::Database& db, const std::vector<View>& views) {
     retrieval_options.fps = db.build_info().fps;
     retrieval_options.selection = recon::Selection::path;
     retrieval_options.smoothing = recon::Smoothing::savitzky_golay;
-    retrieval_options.camera = v.intrinsics;
+    retrieval_options.camera = v.camera;
     FitOptions options;
-    options.camera = recon::pinhole_of(v.intrinsics);
+    options.camera = v.camera;
     options.ground = GroundPlane{kUp, 0.0};
-    out.fits.push_back(reconstruct_and_fit(matcher, bones, &contacts, v.input, v.camera,
-                                           retrieval_options, options, {true, true}));
+    out.fits.push_back(reconstruct_and_fit(matcher, bones, &contacts, v.input, retrieval_options,
+                                           options, {true, true}));
     const ViewFits& f = out.fits.back();
     EXPECT_EQ(f.retrieved.size(), v.input.size());
     EXPECT_EQ(f.full.size(), v.input.size());
     EXPECT_EQ(f.live.size(), v.input.size());
-    const glm::dmat3 to_world = glm::mat3_cast(v.camera.rotation);
+    const glm::dmat3 to_world = glm::transpose(v.camera.rotation);
     auto &t = truth.emplace_back(), &r = retrieval.emplace_back(), &g = fitted.emplace_back();
     for (std::size_t i = 0; i < v.input.size(); ++i) {
       t.push_back(eval::to_world_root_relative(v.truth_camera[i], to_world));
@@ -97,7 +92,7 @@ TEST(ViewFit, HumanEvaChunkSeenByItsThreeCameras) {
   for (int c = 0; c < 3; ++c) {
     const auto& s = sequences[first + c];
     ASSERT_EQ(s.camera.name, cameras.at(s.subject).cameras.at(c).name);
-    View v{s.input, s.truth_camera, s.camera, pose_of(s.camera)};
+    View v{s.input, s.truth_camera, s.camera};
     v.input.resize(24);
     v.truth_camera.resize(24);
     views.push_back(v);
@@ -129,8 +124,7 @@ TEST(ViewFit, Pose2SimBalancingTrialSeenByItsFourCameras) {
   std::vector<View> views;
   for (const auto& v : trial.views) {
     views.push_back({eval::resample_keypoints(v.input, trial.fps, fps),
-                     eval::resample_bodies(v.truth_camera, trial.fps, fps), v.camera,
-                     pose_of(v.camera)});
+                     eval::resample_bodies(v.truth_camera, trial.fps, fps), v.camera});
   }
   ASSERT_EQ(views.size(), 4u);
   EXPECT_EQ(views[0].input.size(), 16u);

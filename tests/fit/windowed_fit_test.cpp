@@ -20,7 +20,7 @@ using Clock = std::chrono::steady_clock;
 fit::FitOptions options() {
   fit::FitOptions o;
   o.camera = test::fit_camera();
-  o.ground = fit::GroundPlane{{0.0, 1.0, 0.0}, 0.0};  // the clip's world: y up
+  o.ground = GroundPlane{{0.0, 1.0, 0.0}, 0.0};  // the clip's world: y up
   return o;
 }
 
@@ -127,7 +127,7 @@ TEST(WindowedFit, TheCostPerFrameDoesNotGrowWithTheTrackLength) {
     s.world.assign(world.begin(), world.begin() + static_cast<std::ptrdiff_t>(count));
     s.rendered =
         eval::render({"07_01", s.world}, {"level", 30.0f, 1.5f, 0.0f, 4.5f}, {}, {0.02f, 0.0f}, 7);
-    s.cameras = fit::camera_poses(s.world, s.rendered.truth_camera);
+    s.cameras = fit::moving_cameras(test::fit_camera(), s.world, s.rendered.truth_camera);
     return s;
   };
   fit::FitStats short_stats, long_stats;

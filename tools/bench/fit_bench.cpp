@@ -246,7 +246,6 @@ int main(int argc, char** argv) {
     const eval::Image image;
     const camera::Camera lens =
         camera::Camera::from_fov(image.width, image.height, image.horizontal_fov_deg);
-    const recon::Pinhole pinhole = recon::pinhole_of(lens);  // what components/fit takes
 
     recon::Matcher matcher(db, {});
     const recon::FrameBones bones(db);
@@ -259,9 +258,9 @@ int main(int argc, char** argv) {
     retrieval.refine_view = true;
 
     fit::FitOptions options;
-    options.camera = pinhole;
+    options.camera = lens;  // each frame's moving camera places it in the clip's world
     options.ankle_clearance_m = args.number("clearance");
-    if (!args.has("no-ground")) options.ground = fit::GroundPlane{{0.0, 1.0, 0.0}, 0.0};
+    if (!args.has("no-ground")) options.ground = GroundPlane{{0.0, 1.0, 0.0}, 0.0};
     options.lag = static_cast<int>(args.integer("lag"));
     options.live_iterations = static_cast<int>(args.integer("live-iterations"));
     options.max_iterations = static_cast<int>(args.integer("iterations"));
@@ -324,7 +323,7 @@ int main(int argc, char** argv) {
             const auto& world = clips[s].world;
             const auto poses =
                 recon::reconstruct_sequence(matcher, bones, rendered.input, retrieval);
-            const auto cams = fit::camera_poses(world, rendered.truth_camera);
+            const auto cams = fit::moving_cameras(lens, world, rendered.truth_camera);
             const auto inputs = fit::make_inputs(
                 rendered.input, poses,
                 use_contact ? detector.contacts(poses) : std::vector<std::array<bool, 2>>{}, cams);
@@ -347,9 +346,8 @@ int main(int argc, char** argv) {
             rows[{methods[0], len, cond}].add(truth_row);
             Row retrieved;
             retrieved.pose = eval::score(poses, rendered.truth_camera);
-            retrieved.placement =
-                fit::score_placement(fit::placed_retrieval(inputs, pinhole), rendered.truth_camera,
-                                     cams, contacts, floor);
+            retrieved.placement = fit::score_placement(
+                fit::placed_retrieval(inputs, lens), rendered.truth_camera, cams, contacts, floor);
             rows[{methods[1], len, cond}].add(retrieved);
             for (const auto& v : variants) {
               const std::string suffix = v.label.empty() ? "" : " [" + v.label + "]";

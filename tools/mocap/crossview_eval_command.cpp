@@ -31,7 +31,6 @@
 #include "fit/fit_evaluation.hpp"
 #include "fit/foot_contact.hpp"
 #include "fit/view_fit.hpp"
-#include "fit_cameras.hpp"
 #include "output_files.hpp"
 #include "posedb/parallel_chunks.hpp"
 #include "progress_bar.hpp"
@@ -228,7 +227,7 @@ int crossview_eval_command(int argc, char** argv) {
 
   fit::FitOptions fit_options;
   fit_options.ankle_clearance_m = args.number("clearance");
-  if (!args.has("no-ground")) fit_options.ground = fit::GroundPlane{kUp, 0.0};
+  if (!args.has("no-ground")) fit_options.ground = GroundPlane{kUp, 0.0};
   const recon::FrameBones bones(db);
   const fit::ContactDetector contacts(db);
   std::vector<fit::ViewFits> fits(jobs.size());
@@ -246,9 +245,8 @@ int crossview_eval_command(int argc, char** argv) {
         retrieval.camera = job.camera;
         retrieval.refine_view = true;
         fit::FitOptions options = fit_options;
-        options.camera = recon::pinhole_of(job.camera);
-        fits[i] = fit::reconstruct_and_fit(matcher, bones, &contacts, job.input,
-                                           fit_camera_pose(job.camera), retrieval, options,
+        options.camera = job.camera;  // intrinsics and its place in the world
+        fits[i] = fit::reconstruct_and_fit(matcher, bones, &contacts, job.input, retrieval, options,
                                            {true, false});
       },
       [&](std::size_t done) {

@@ -25,7 +25,6 @@
 #include "fit/fit_evaluation.hpp"
 #include "fit/foot_contact.hpp"
 #include "fit/view_fit.hpp"
-#include "fit_cameras.hpp"
 #include "output_files.hpp"
 #include "posedb/parallel_chunks.hpp"
 #include "progress_bar.hpp"
@@ -132,12 +131,9 @@ int humaneva_fit_command(int argc, char** argv) {
   fit::FitOptions fit_options;
   fit_options.lag = static_cast<int>(args.integer("lag"));
   fit_options.ankle_clearance_m = args.number("clearance");
-  // HumanEva's world is Z up with the floor at Z = 0 (the rigs' floor); the camera poses carry it
-  // into each view.
-  if (!args.has("no-ground")) {
-    const GroundPlane& floor = cameras.begin()->second.floor.value();
-    fit_options.ground = fit::GroundPlane{floor.normal, floor.offset};
-  }
+  // HumanEva's world is Z up with the floor at Z = 0 (the rigs' floor); each camera's pose
+  // carries it into its view.
+  if (!args.has("no-ground")) fit_options.ground = cameras.begin()->second.floor.value();
 
   std::vector<std::array<Result, 3>> results(sequences.size());
   ProgressBar bar;
@@ -153,13 +149,12 @@ int humaneva_fit_command(int argc, char** argv) {
         retrieval.camera = s.camera;
         retrieval.refine_view = true;
         fit::FitOptions options = fit_options;
-        options.camera = recon::pinhole_of(s.camera);
-        const fit::CameraPose pose = fit_camera_pose(s.camera);
+        options.camera = s.camera;  // intrinsics and its place in the world
         std::vector<recon::BodyXyc> input = s.input;
         eval::InputNoise noise(1000003ull * i);
         for (auto& frame : input) noise.apply(condition, frame);
         const fit::ViewFits fits =
-            fit::reconstruct_and_fit(matcher, bones, &contacts, input, pose, retrieval, options);
+            fit::reconstruct_and_fit(matcher, bones, &contacts, input, retrieval, options);
         results[i][0] = score(fits.placed, fits.retrieved, s.truth_camera);
         results[i][1] = score(fits.full, fit::as_poses(fits.full), s.truth_camera);
         results[i][2] = score(fits.live, fit::as_poses(fits.live), s.truth_camera);

@@ -61,11 +61,15 @@ class FitNode : public Node {
     db_.emplace(posedb::Database::open(ctx.param<std::string>("db")));
     if (ctx.param<bool>("contact")) o.contacts = &contacts_.emplace(*db_);
     camera_ = read_camera_params(ctx);
-    if (!camera_.pinhole.valid())
+    if (!camera_.known())
       throw std::invalid_argument(
           "the fitting needs the camera: set 'camera' (a calibration file) or 'image_width' and "
           "'image_height' (with 'hfov_deg')");
-    o.fit.camera = camera_.pinhole;
+    // The fit places people in the camera's frame (its floor is the camera file's, in that frame):
+    // the camera file's pose, if any, is not the fit's world.
+    o.fit.camera = camera_.camera;
+    o.fit.camera.rotation = glm::dmat3(1.0);
+    o.fit.camera.translation = glm::dvec3(0.0);
     o.undistort = [this](std::array<Keypoint2D, kBodyJoints>& k) { undistort(camera_, k); };
     o.estimate_ground = ground != "off";
     if (camera_.assumed) {
@@ -74,8 +78,7 @@ class FitNode : public Node {
                 << "image centre, no distortion\n";
     } else if (ground == "auto") {
       if (const auto p = camera::read_ground_plane(ctx.param<std::string>("camera")))
-        o.calibrated_ground =
-            fit::GroundPlane{{p->normal[0], p->normal[1], p->normal[2]}, p->offset};
+        o.calibrated_ground = *p;
     }
     fitter_.emplace(std::move(o));
   }

@@ -37,7 +37,6 @@ NodeCamera read_camera_params(const graph::Context& ctx) {
     out.camera = camera::Camera::from_fov(width, height, out.hfov_deg);
     out.assumed = true;
   }
-  out.pinhole = recon::pinhole_of(out.camera);
   return out;
 }
 

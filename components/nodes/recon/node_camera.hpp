@@ -8,15 +8,13 @@
 #include "camera/camera.hpp"
 #include "core/messages.hpp"
 #include "graph/node.hpp"
-#include "recon/ray_alignment.hpp"
 
 namespace mocap::nodes {
 
 struct NodeCamera {
-  camera::Camera camera;   // without intrinsics (fx 0): neither a file nor an image size
-  recon::Pinhole pinhole;  // the same intrinsics for recon.fit (components/fit takes these)
-  bool assumed = false;    // the pinhole of a field of view, not calibrated
-  double hfov_deg = 0.0;   // when assumed
+  camera::Camera camera;  // without intrinsics (fx 0): neither a file nor an image size
+  bool assumed = false;   // the pinhole of a field of view, not calibrated
+  double hfov_deg = 0.0;  // when assumed
 
   bool known() const { return camera.has_intrinsics(); }
 };

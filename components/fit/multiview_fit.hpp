@@ -1,0 +1,93 @@
+#pragma once
+// Skeleton fitting on several calibrated views (issue 19): per person, the 15-joint body with
+// constant bone lengths is solved in the rig's world so that its joints project onto the
+// person's keypoints in every camera that saw them, moving smoothly, with soft knee limits and
+// the ankles above the rig's floor. The same window problem as the monocular fit
+// (window_problem.cpp): its variables are in the world instead of a camera's frame, and each
+// frame carries one reprojection term per view instead of one. Started from, and held weakly
+// near, the triangulated joints of components/multiview (the bone directions' reference and the
+// root's start). docs/fitting.md "Several views", docs/multiview.md "Fitting".
+//
+// Keypoints are given undistorted (camera::Camera::undistort_pixels, as components/multiview
+// takes them): the fit uses each camera's pinhole and pose only.
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "camera/camera.hpp"
+#include "fit/skeleton_fit.hpp"
+
+namespace mocap::fit {
+
+// One camera's sight of the person at one frame.
+struct ViewKeypoints {
+  int camera = 0;  // index in MultiViewFitOptions::cameras
+  recon::BodyXyc
+      keypoints{};  // 15 × (x, y, confidence), undistorted pixels; confidence 0 = missing
+};
+
+// One frame of one person.
+struct MultiViewFrameInput {
+  std::vector<ViewKeypoints> views;  // none: the person was not seen (filled by smoothness)
+  // The triangulated joints (world, metres; a non-finite joint was not triangulated), e.g.
+  // multiview::FrameResult::body_of. The frame is fitted when its root is triangulated.
+  Body triangulated = not_triangulated();
+  std::array<bool, 2> contact{};  // right, left ankle in contact with the floor (kFeet order)
+
+  static Body not_triangulated();
+};
+
+struct MultiViewFitOptions {
+  std::vector<camera::Camera> cameras;  // the rig's, in its order
+  // Weights, the floor (FitOptions::ground: the rig's floor, world), lag and iterations; its
+  // camera is not used. multiview_fit_defaults() sets the weights chosen for several views.
+  FitOptions fit;
+  // Live mode: the bone lengths are the triangulated medians of the first `bone_frames` observed
+  // frames of a track (0: lag + 1), fixed from then on; until then the track's frames are held
+  // (a new person's first second comes out after a second, then every frame `lag` frames late).
+  // Not used with fit.bones. 30 (1 s at 30 fps): chosen on the train scenes (docs/fitting.md).
+  int bone_frames = 30;
+};
+
+// FitOptions with the weights chosen on the virtual multi-view scenes of CMU train clips
+// (docs/fitting.md "Several views"): the triangulation is a far better start than a monocular
+// retrieval, so its directions hold less and the reprojection in every view decides.
+FitOptions multiview_fit_defaults();
+
+// The per-bone median of the triangulated bone lengths (bones with both ends triangulated).
+BoneLengths triangulated_bone_lengths(std::span<const MultiViewFrameInput> frames);
+
+// Full mode: every frame in one problem, the bone lengths shared and solved (started from the
+// triangulated medians, or options.fit.bones). Frames before the first and after the last
+// triangulated root are invalid.
+FitResult fit_multiview_sequence(std::span<const MultiViewFrameInput> frames,
+                                 const MultiViewFitOptions& options);
+
+// Fixed-lag live mode, as LiveFitter: each push solves the newest lag + 1 frames against the two
+// emitted, frozen ones before them and returns the frame that is now `lag` frames old. The bone
+// lengths are options.fit.bones, else the triangulated medians of the track's first
+// bone_frames observed frames; until those are in, frames are held, then solved together and
+// returned at once: every output of a track has the same skeleton.
+class MultiViewLiveFitter {
+ public:
+  explicit MultiViewLiveFitter(MultiViewFitOptions options);
+  ~MultiViewLiveFitter();
+  MultiViewLiveFitter(MultiViewLiveFitter&&) noexcept;
+  MultiViewLiveFitter& operator=(MultiViewLiveFitter&&) noexcept;
+
+  // The frames that became final, in order: none while the bones are not known, then all the
+  // frames held, then one per push.
+  std::vector<FittedFrame> push(const MultiViewFrameInput& frame);
+  std::vector<FittedFrame> finish();  // the frames still held, solved if they never were
+  const BoneLengths& bones() const;
+  const FitStats& stats() const;
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
+
+}  // namespace mocap::fit

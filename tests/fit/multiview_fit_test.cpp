@@ -1,0 +1,184 @@
+// The skeleton fit on several views (fit/multiview_fit.hpp) on virtual scenes of CMU train clips:
+// 3 people, 4 cameras, the target degradation (σ 2 %, drops, outliers, false detections,
+// occlusion), reconstructed by components/multiview and then fitted live and in full.
+
+#include <cmath>
+#include <map>
+#include <stdexcept>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "fit/multiview_fit.hpp"
+#include "fit/multiview_input.hpp"
+#include "fit/scene_fit.hpp"
+#include "multiview/scene_fixture.hpp"
+
+namespace mocap::fit {
+namespace {
+
+constexpr int kFrames = 90;
+constexpr int kCameras = 4;
+
+struct Scene {
+  std::vector<eval::SceneCamera> rig;
+  std::vector<eval::SceneFrame> frames;
+  std::vector<multiview::FrameObservations> input;
+  std::vector<multiview::FrameResult> results;
+};
+
+Scene reconstruct(int people_count, std::uint64_t seed = 1) {
+  Scene s;
+  const auto people = test::scene_people(people_count, kFrames);
+  s.rig = test::scene_rig(kCameras, 4);
+  eval::SceneRenderer renderer(s.rig, seed);
+  multiview::ReconstructionOptions options;
+  options.tracker.fps = test::kSceneFps;
+  multiview::MultiViewReconstructor reconstructor(test::geometries(s.rig),
+                                                  multiview::KeypointSet::body15(), options);
+  for (int f = 0; f < kFrames; ++f) {
+    s.frames.push_back(renderer.render(people, f, test::target_degradation()));
+    eval::SceneRenderer::to_observations(s.frames.back(), s.input.emplace_back());
+    s.results.push_back(reconstructor.process(s.input.back(), f));
+  }
+  return s;
+}
+
+eval::SceneScore score(const Scene& s, const std::vector<multiview::FrameResult>& results) {
+  eval::SceneScorer scorer(static_cast<int>(s.frames.front().truth.size()));
+  for (std::size_t f = 0; f < s.frames.size(); ++f) scorer.add(s.frames[f], results[f]);
+  return scorer.score();
+}
+
+// The largest, over tracks and bones, standard deviation of a bone's length (metres).
+double worst_bone_std_m(const std::vector<multiview::FrameResult>& results) {
+  std::map<int, std::array<std::vector<double>, kBodyJoints>> lengths;
+  for (const auto& r : results)
+    for (std::size_t p = 0; p < r.people.size(); ++p) {
+      if (r.people[p].id < 0) continue;
+      const auto body = r.body_of(p);
+      for (int j = 0; j < kBodyJoints; ++j) {
+        if (kJointParent[j] < 0) continue;
+        if (!body[j].valid() || !body[kJointParent[j]].valid()) continue;
+        lengths[r.people[p].id][j].push_back(
+            glm::distance(body[j].position, body[kJointParent[j]].position));
+      }
+    }
+  double worst = 0.0;
+  for (const auto& [id, bones] : lengths)
+    for (const auto& v : bones) {
+      if (v.size() < 2) continue;
+      double mean = 0.0, var = 0.0;
+      for (double x : v) mean += x;
+      mean /= static_cast<double>(v.size());
+      for (double x : v) var += (x - mean) * (x - mean);
+      worst = std::max(worst, std::sqrt(var / static_cast<double>(v.size())));
+    }
+  return worst;
+}
+
+MultiViewFitOptions options_for(const Scene& s) {
+  MultiViewFitOptions o;
+  o.cameras = scene_cameras(s.rig);
+  o.fit = multiview_fit_defaults();
+  o.fit.ground = GroundPlane{{0.0, 1.0, 0.0}, 0.0};  // the scene's floor: y = 0, y up
+  return o;
+}
+
+TEST(MultiViewFit, LiveAndFullBeatTheTriangulationWithConstantBones) {
+  MOCAP_REQUIRE_SCENE_CLIPS();
+  const Scene s = reconstruct(3);
+  const eval::SceneScore triangulated = score(s, s.results);
+  ASSERT_GT(triangulated.reconstructed, 200) << test::describe(triangulated);
+  const MultiViewFitOptions options = options_for(s);
+  for (const bool live : {true, false}) {
+    std::vector<multiview::FrameResult> results = s.results;
+    const TrackFits fits = fit_tracks(s.input, results, options, live);
+    const eval::SceneScore fitted = score(s, results);
+    SCOPED_TRACE(live ? "live" : "full");
+    EXPECT_GE(fits.tracks, 3);
+    // Every reconstructed person of a track gets a fitted body of all 15 joints.
+    EXPECT_EQ(fits.person_frames, triangulated.reconstructed + triangulated.duplicates);
+    EXPECT_EQ(fitted.joints, 15 * fitted.reconstructed);
+    // Fewer joints triangulated than fitted, yet the fit is clearly closer to the truth.
+    EXPECT_LT(fitted.mpjpe_mm(), 0.9 * triangulated.mpjpe_mm())
+        << "triangulated " << test::describe(triangulated) << "\nfitted " << test::describe(fitted);
+    // One skeleton per track: the triangulation's bones vary by centimetres, the fit's not at all.
+    EXPECT_GT(worst_bone_std_m(s.results), 0.01);
+    EXPECT_LT(worst_bone_std_m(results), 1e-4);
+    EXPECT_EQ(fitted.id_switches, triangulated.id_switches);
+  }
+}
+
+TEST(MultiViewFit, ExactKeypointsGiveTheTruthBack) {
+  MOCAP_REQUIRE_SCENE_CLIPS();
+  // One person, noiseless keypoints in every camera, the truth as the triangulation: the fit
+  // keeps the body where it is (a bias of any term would move it).
+  const auto people = test::scene_people(1, 30);
+  const auto rig = test::scene_rig(kCameras, 4);
+  MultiViewFitOptions options;
+  options.cameras = scene_cameras(rig);
+  options.fit = multiview_fit_defaults();
+  std::vector<MultiViewFrameInput> frames(30);
+  for (int f = 0; f < 30; ++f) {
+    const Body truth = *people[0].at(f);
+    frames[f].triangulated = truth;
+    for (int v = 0; v < kCameras; ++v) {
+      ViewKeypoints& view = frames[f].views.emplace_back();
+      view.camera = v;
+      for (int j = 0; j < kBodyJoints; ++j) {
+        const glm::dvec2 px = options.cameras[v].project(glm::dvec3(truth[j]));
+        view.keypoints[3 * j] = static_cast<float>(px.x);
+        view.keypoints[3 * j + 1] = static_cast<float>(px.y);
+        view.keypoints[3 * j + 2] = 1.0f;
+      }
+    }
+  }
+  const FitResult full = fit_multiview_sequence(frames, options);
+  MultiViewLiveFitter live(options);
+  std::vector<FittedFrame> live_frames;
+  for (const auto& f : frames)
+    for (auto& r : live.push(f)) live_frames.push_back(r);
+  for (auto& r : live.finish()) live_frames.push_back(r);
+  ASSERT_EQ(live_frames.size(), frames.size());
+  double full_mm = 0.0, live_mm = 0.0;
+  for (int f = 0; f < 30; ++f) {
+    ASSERT_TRUE(full.frames[f].valid);
+    ASSERT_TRUE(live_frames[f].valid);
+    for (int j = 0; j < kBodyJoints; ++j) {
+      full_mm += 1000.0 * glm::distance(full.frames[f].joints[j], frames[f].triangulated[j]);
+      live_mm += 1000.0 * glm::distance(live_frames[f].joints[j], frames[f].triangulated[j]);
+    }
+  }
+  EXPECT_LT(full_mm / (30 * kBodyJoints), 3.0);
+  EXPECT_LT(live_mm / (30 * kBodyJoints), 3.0);
+}
+
+TEST(MultiViewFit, UnseenFramesAndBadCameraIndices) {
+  MultiViewFitOptions options;
+  options.cameras = {camera::Camera::from_fov(640, 480, 60.0)};
+  options.fit = multiview_fit_defaults();
+  // Nothing triangulated: nothing fitted, nothing thrown.
+  const std::vector<MultiViewFrameInput> empty(5);
+  const FitResult none = fit_multiview_sequence(empty, options);
+  ASSERT_EQ(none.frames.size(), 5u);
+  for (const auto& f : none.frames) EXPECT_FALSE(f.valid);
+  MultiViewLiveFitter live(options);
+  for (const auto& f : empty) {
+    for (const auto& out : live.push(f)) EXPECT_FALSE(out.valid);
+  }
+  for (const auto& f : live.finish()) EXPECT_FALSE(f.valid);
+  // Keypoints of a camera the rig does not have: refused, naming it.
+  std::vector<MultiViewFrameInput> bad(1);
+  bad[0].triangulated.fill(glm::vec3(0.0f, 1.0f, 3.0f));
+  bad[0].views.push_back({3, {}});
+  try {
+    fit_multiview_sequence(bad, options);
+    FAIL() << "expected std::invalid_argument";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("camera 3"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace mocap::fit
