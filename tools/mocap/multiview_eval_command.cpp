@@ -41,6 +41,8 @@ std::vector<eval::MultiviewCase> cases(const Args& args) {
   std::vector<int> views = {2, 3, 4, 6, 8, 16}, people = {1, 2, 3, 4, 6};
   std::vector<float> noise = {0.0f, 0.01f, 0.02f, 0.05f};
   if (args.has("views")) views = whole_numbers(args, "views");
+  for (const int v : views)
+    if (v < 2) throw InputError("--views", "a multi-view scene needs two cameras or more");
   if (args.has("people")) people = whole_numbers(args, "people");
   if (args.has("noise")) {
     noise.clear();
