@@ -1,9 +1,12 @@
-// `mocap rig info` and `mocap rig convert` driven as a user would: the built binary in a child
-// process, on Pose2Sim's demo calibration (skips without it) and on a single-camera file.
+// `mocap rig info`, `mocap rig convert` and `mocap rig offsets` driven as a user would: the built
+// binary in a child process, on Pose2Sim's demo calibration (skips without it) and on a
+// single-camera file.
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -85,6 +88,44 @@ TEST(RigCommand, BadFilesAndNamesAreRefusedNamingThem) {
   EXPECT_FALSE(std::filesystem::exists(dir.file("out.txt")));
   test::Mocap usage(dir, "usage", {"rig", "convert", dir.file("cam.yml")});
   EXPECT_EQ(usage.wait(60s), 2);
+}
+
+// Pose2Sim's demo with cam04 as if it started 5 frames late (its first 5 files left out): the
+// offset of cam04 comes back as +5; too few views are refused naming the rig and the counts.
+TEST(RigCommand, OffsetsFindAViewThatStartedLate) {
+  MOCAP_REQUIRE_SHARED("eval/pose2sim_demo/S00_P00_T01_BalancingTrial/pose/cam04_json");
+  const auto demo = test::shared_data() / "eval" / "pose2sim_demo";
+  const std::string toml = (demo / "calibration" / "Calib_qualisys.toml").string();
+  test::TempDir dir;
+  std::vector<std::string> args = {"rig", "offsets", toml};
+  for (int c = 1; c <= 4; ++c) {
+    const std::string name = "cam0" + std::to_string(c) + "_json";
+    const auto view = std::filesystem::path(dir.file(name));
+    std::filesystem::create_directories(view);
+    std::vector<std::filesystem::path> files;
+    for (const auto& e :
+         std::filesystem::directory_iterator(demo / "S00_P00_T01_BalancingTrial" / "pose" / name))
+      files.push_back(e.path());
+    std::sort(files.begin(), files.end());
+    for (std::size_t i = c == 4 ? 5 : 0; i < files.size(); ++i)
+      std::filesystem::copy_file(files[i], view / files[i].filename());
+    args.push_back(view.string());
+  }
+  args.insert(args.end(), {"--layout", "BODY_25B"});
+  test::Mocap run(dir, "offsets", args);
+  run.wait(60s);
+  const std::string out = run.out();
+  const std::string cam04 = "| 4 | cam_04 | 95 | ";
+  const auto row = out.find(cam04);
+  ASSERT_NE(row, std::string::npos) << out << run.err();
+  const double offset = std::stod(out.substr(row + cam04.size()));
+  EXPECT_NEAR(offset, 5.0, 0.5) << out;
+  args.pop_back();
+  args.pop_back();
+  args.pop_back();  // three views for four cameras
+  test::Mocap few(dir, "few", args);
+  EXPECT_EQ(few.wait(60s), 1);
+  EXPECT_NE(few.err().find("4 cameras, 3 views given"), std::string::npos) << few.err();
 }
 
 }  // namespace

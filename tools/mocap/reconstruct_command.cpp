@@ -43,6 +43,7 @@
 #include "posedb/database.hpp"
 #include "progress_bar.hpp"
 #include "reconstruct_outputs.hpp"
+#include "reconstruct_report.hpp"
 #include "video/video_source.hpp"
 
 namespace mocap::cli {
@@ -187,27 +188,6 @@ void choose_detector(graph::GraphSpec& spec, const std::string& name) {
   if (!found) throw InputError("--detector", "the graph has no detector node to replace");
 }
 
-// A graph with detector nodes on the cached models: a missing model is reported before anything
-// runs, naming the command that fetches it.
-void check_detector_model(const graph::GraphSpec& spec) {
-  const auto given = [](const graph::NodeSpec& node, const char* key) {
-    const auto it = node.params.find(key);
-    return it != node.params.end() && !it->second.text.empty();
-  };
-  for (const auto& node : spec.nodes) {
-    if (node.type == "detect.movenet" || node.type == "detect.tiles") {
-      if (!given(node, "model")) detect::movenet_model_json();
-    } else if (node.type == "detect.topdown") {
-      if (!given(node, "box_model_file")) detect::cached_model_json("centernet");
-      if (!given(node, "pose_model_file")) {
-        const auto it = node.params.find("pose_model");
-        const bool thunder = it != node.params.end() && it->second.text == "thunder";
-        detect::cached_model_json(thunder ? "movenet-thunder" : "movenet-lightning");
-      }
-    }
-  }
-}
-
 // What --layout-offsets means for the matcher: auto names the input's layout (MoveNet's COCO-17
 // for video; for OpenPose JSON, the layout of the folder's first file), whose file in
 // calibration/layouts/ is then used; off and files pass through.
@@ -313,32 +293,6 @@ void check_keypoints_inside(const std::string& folder, int width, int height,
   }
 }
 
-// What the run produced, read back from poses.jsonl: frames, people, track lengths. Only whole
-// lines count: a last line without its newline was cut by a kill.
-json summarize_output(const fs::path& jsonl) {
-  std::ifstream in(jsonl, std::ios::binary);
-  std::map<int, int> frames_per_id;
-  std::size_t frames = 0, person_frames = 0, placed = 0;
-  for (std::string line; std::getline(in, line);) {
-    if (in.eof()) break;  // no newline after it
-    const json j = json::parse(line, nullptr, false);
-    if (j.is_discarded()) continue;
-    ++frames;
-    for (const auto& p : j.value("people", json::array())) {
-      ++frames_per_id[p.value("id", -1)];
-      ++person_frames;
-      placed += p.contains("joints_abs") ? 1 : 0;
-    }
-  }
-  int long_tracks = 0;
-  for (const auto& [id, n] : frames_per_id) long_tracks += n > 50 ? 1 : 0;
-  return {{"frames", frames},
-          {"people", frames_per_id.size()},
-          {"person_frames", person_frames},
-          {"placed_person_frames", placed},
-          {"tracks_longer_than_50_frames", long_tracks}};
-}
-
 // The database and camera file are read now, before DIR is touched: a missing, damaged (checksums)
 // or foreign file ends the command with nothing written.
 void check_database_and_camera(const Args& args) {
@@ -364,6 +318,55 @@ void refuse_outputs_over_inputs(const Args& args, const fs::path& out,
   refuse_output_over_inputs({"--out", out.string()}, {inputs[0]});
   for (const char* name : {"poses.jsonl", "summary.json", "overlay.mp4"})
     refuse_output_over_inputs({"--out", (out / name).string()}, inputs);
+}
+
+}  // namespace
+
+// A graph with detector nodes on the cached models: a missing model is reported before anything
+// runs, naming the command that fetches it.
+void check_detector_model(const graph::GraphSpec& spec) {
+  const auto given = [](const graph::NodeSpec& node, const char* key) {
+    const auto it = node.params.find(key);
+    return it != node.params.end() && !it->second.text.empty();
+  };
+  for (const auto& node : spec.nodes) {
+    if (node.type == "detect.movenet" || node.type == "detect.tiles") {
+      if (!given(node, "model")) detect::movenet_model_json();
+    } else if (node.type == "detect.topdown") {
+      if (!given(node, "box_model_file")) detect::cached_model_json("centernet");
+      if (!given(node, "pose_model_file")) {
+        const auto it = node.params.find("pose_model");
+        const bool thunder = it != node.params.end() && it->second.text == "thunder";
+        detect::cached_model_json(thunder ? "movenet-thunder" : "movenet-lightning");
+      }
+    }
+  }
+}
+
+// What the run produced, read back from poses.jsonl: frames, people, track lengths. Only whole
+// lines count: a last line without its newline was cut by a kill.
+json summarize_output(const fs::path& jsonl) {
+  std::ifstream in(jsonl, std::ios::binary);
+  std::map<int, int> frames_per_id;
+  std::size_t frames = 0, person_frames = 0, placed = 0;
+  for (std::string line; std::getline(in, line);) {
+    if (in.eof()) break;  // no newline after it
+    const json j = json::parse(line, nullptr, false);
+    if (j.is_discarded()) continue;
+    ++frames;
+    for (const auto& p : j.value("people", json::array())) {
+      ++frames_per_id[p.value("id", -1)];
+      ++person_frames;
+      placed += p.contains("joints_abs") || p.contains("joints_world") ? 1 : 0;
+    }
+  }
+  int long_tracks = 0;
+  for (const auto& [id, n] : frames_per_id) long_tracks += n > 50 ? 1 : 0;
+  return {{"frames", frames},
+          {"people", frames_per_id.size()},
+          {"person_frames", person_frames},
+          {"placed_person_frames", placed},
+          {"tracks_longer_than_50_frames", long_tracks}};
 }
 
 json files_json(const std::vector<fs::path>& files) {
@@ -430,9 +433,8 @@ json node_latency(const graph::GraphStats& stats) {
   return nodes;
 }
 
-}  // namespace
-
 int reconstruct_command(int argc, char** argv) {
+  if (asks_for_multiview(argc, argv)) return reconstruct_multiview_command(argc, argv);
   Args args(
       "mocap reconstruct INPUT --out DIR [--db DB] [--force] [options]",
       "Reconstructs the 3D motion of every person in a video file, camera device (/dev/videoN),\n"
@@ -449,7 +451,9 @@ int reconstruct_command(int argc, char** argv) {
       "has\n"
       "written its output, put back as they were when it wrote none (it failed at the start).\n"
       "Files are written as the run goes and stay whole, so an interrupted run (Ctrl-C, a kill)\n"
-      "keeps what it wrote under the files' own names; summary.json is written at the end.");
+      "keeps what it wrote under the files' own names; summary.json is written at the end.\n\n"
+      "Several calibrated cameras: mocap reconstruct --calibration RIG VIEW1 VIEW2 ... --out DIR\n"
+      "(see mocap reconstruct --calibration RIG --help).");
   args.positional("INPUT",
                   "video file, /dev/videoN, rtsp:// or http:// URL, image folder, or "
                   "folder of OpenPose *_keypoints.json files")

@@ -1,12 +1,17 @@
-// `mocap rig info RIG` and `mocap rig convert IN OUT`: what a rig file (docs/cameras.md: the
-// Pose2Sim/anipose TOML layout or OpenCV YAML) holds, and the same rig in the other format.
+// `mocap rig info RIG`, `mocap rig convert IN OUT` and `mocap rig offsets RIG VIEW...`: what a
+// rig file (docs/cameras.md: the Pose2Sim/anipose TOML layout or OpenCV YAML) holds, the same rig
+// in the other format, and the frame offsets between views filmed without a common clock.
 
+#include <cstdio>
 #include <iostream>
 
+#include "camera/frame_offsets.hpp"
 #include "camera/rig_file.hpp"
 #include "camera/rig_report.hpp"
 #include "cli_args.hpp"
 #include "commands.hpp"
+#include "core/input_error.hpp"
+#include "io/openpose_json.hpp"
 
 namespace mocap::cli {
 namespace {
@@ -51,12 +56,78 @@ int convert(int argc, char** argv) {
   return 0;
 }
 
+int offsets(int argc, char** argv) {
+  Args args("mocap rig offsets RIG VIEW1 VIEW2 ... [--reference N] [--max-offset F] [--layout L]",
+            "Estimates how many frames each view is shifted against the reference view, from "
+            "where its\npeople lie on the reference's epipolar lines (docs/cameras.md, \"Frame "
+            "offsets\"). VIEW: an\nOpenPose JSON folder per camera, in the rig's camera order. "
+            "Prints per view the offset\n(its frame i shows the reference's frame i + offset) or "
+            "why none was found; exits 1 when\na view has none.");
+  args.positional("RIG", "the rig file")
+      .positional("VIEW", "OpenPose JSON folders, one per camera of the rig, in its order", true)
+      .option("reference", "N", "the view the others are measured against (1 = the first)", "1",
+              Range::count(1, 64))
+      .option("max-offset", "F", "largest offset tried, in frames", "30", Range::count(1, 1000))
+      .option("layout", "L",
+              "25-keypoint files are BODY_25 or BODY_25B (Pose2Sim's); auto: told by the "
+              "keypoints, as source.openpose_json does",
+              "auto");
+  int code = 0;
+  if (!args.parse(argc, argv, code)) return code;
+  const std::string file = args.positionals().at(0);
+  const camera::Rig rig = camera::read_rig(file);
+  const std::vector<std::string> folders(args.positionals().begin() + 1, args.positionals().end());
+  if (folders.size() != rig.cameras.size())
+    throw InputError(file, std::to_string(rig.cameras.size()) + " cameras, " +
+                               std::to_string(folders.size()) +
+                               " views given: give one view per camera, in the rig's order");
+  const auto reference = static_cast<std::size_t>(args.integer("reference") - 1);
+  if (reference >= folders.size())
+    throw InputError("--reference", "view " + std::to_string(reference + 1) + " of " +
+                                        std::to_string(folders.size()));
+  const std::string layout = args.get("layout");
+  if (layout != "auto" && layout != "BODY_25" && layout != "BODY_25B")
+    throw InputError("--layout", "expected auto, BODY_25 or BODY_25B, got '" + layout + "'");
+  io::OpenPoseOptions json_options;
+  json_options.body25 = layout == "auto"       ? io::Body25Choice::detect
+                        : layout == "BODY_25B" ? io::Body25Choice::body25b
+                                               : io::Body25Choice::body25;
+  std::vector<camera::BodySequence> views;
+  for (std::size_t v = 0; v < folders.size(); ++v) {
+    const io::OpenPoseSequence json = io::read_openpose_folder(folders[v], json_options);
+    for (const io::FrameProblem& p : json.problems)
+      std::cerr << "mocap rig offsets: " << folders[v] << ": " << p.message << "\n";
+    views.push_back(camera::body_sequence(json.frames));
+  }
+  camera::OffsetOptions options;
+  options.max_offset_frames = static_cast<int>(args.integer("max-offset"));
+  const auto found = camera::estimate_offsets(rig.cameras, views, reference, options);
+  std::cout
+      << "| view | camera | frames | offset (frames) | contrast | epipolar cost (body heights) |\n"
+         "|---|---|---|---|---|---|\n";
+  int missing = 0;
+  for (std::size_t v = 0; v < found.size(); ++v) {
+    char offset[32] = "reference";
+    if (v != reference) std::snprintf(offset, sizeof offset, "%+.2f", found[v].frames);
+    char row[256];
+    std::snprintf(row, sizeof row, "| %zu | %s | %zu | %s%s | %.2f | %.4f |\n", v + 1,
+                  rig.cameras[v].name.c_str(), views[v].size(), offset,
+                  found[v].found ? "" : " (none)", found[v].contrast, found[v].cost);
+    std::cout << row;
+    if (!found[v].found) ++missing;
+  }
+  for (std::size_t v = 0; v < found.size(); ++v)
+    if (!found[v].found) std::cout << rig.cameras[v].name << ": " << found[v].problem << "\n";
+  return missing == 0 ? 0 : 1;
+}
+
 }  // namespace
 
 int rig_command(int argc, char** argv) {
   static constexpr Subcommand kSubcommands[] = {
       {"info", "a rig's cameras, positions, baselines, angles and floor", info},
       {"convert", "a rig file in the other format (TOML <-> OpenCV YAML)", convert},
+      {"offsets", "frame offsets between views filmed without a common clock", offsets},
   };
   return run_subcommand("rig", kSubcommands, argc, argv);
 }

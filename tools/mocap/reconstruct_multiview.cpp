@@ -1,0 +1,337 @@
+// `mocap reconstruct --calibration RIG VIEW1 VIEW2 ... --out DIR`: several calibrated views of one
+// scene (each a folder of OpenPose JSON, a video file or an image folder, in the rig's camera
+// order) to the people in the rig's world: poses.jsonl with each person's joints_world, one BVH
+// per person (y up, the floor at y = 0) and summary.json. Builds the graph of
+// graphs/multiview_json.yaml (or its video form) for the number of views, after checking what can
+// be checked before DIR is touched: the rig, one view per camera, the views' image sizes against
+// the rig's.
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <iostream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "camera/rig_file.hpp"
+#include "cli_args.hpp"
+#include "core/input_error.hpp"
+#include "core/install_paths.hpp"
+#include "detector_presets.hpp"
+#include "eval_report.hpp"
+#include "graph/graph_spec.hpp"
+#include "graph/plugins.hpp"
+#include "graph/validation.hpp"
+#include "graph_runner.hpp"
+#include "io/openpose_json.hpp"
+#include "multiview/rig_reconstruction.hpp"
+#include "output_files.hpp"
+#include "progress_bar.hpp"
+#include "reconstruct_report.hpp"
+#include "video/video_source.hpp"
+
+namespace mocap::cli {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+enum class ViewKind { openpose_json, video };
+
+struct View {
+  std::string path;
+  ViewKind kind = ViewKind::openpose_json;
+  const camera::Camera* camera = nullptr;
+  std::int64_t frames = -1;
+  double fps = 0.0;  // videos: their own rate
+};
+
+ViewKind view_kind(const std::string& path) {
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) {
+    bool images = false;
+    for (const auto& e : fs::directory_iterator(path, ec)) {
+      const std::string name = e.path().filename().string();
+      if (name.ends_with(".json")) return ViewKind::openpose_json;
+      images = images || video::is_image_file_name(name);
+    }
+    if (images) return ViewKind::video;
+    throw InputError(path,
+                     "neither OpenPose JSON files (*.json) nor images (.png, .jpg, ...) here");
+  }
+  if (video::classify(path) == video::SourceKind::file && !fs::exists(path, ec))
+    throw InputError(path, "no such file or folder");
+  return ViewKind::video;
+}
+
+std::string size_text(int width, int height) {
+  return std::to_string(width) + "x" + std::to_string(height);
+}
+
+// The keypoints of a JSON view must lie in its camera's image: keypoints beyond it mean the view
+// is another camera's (the order of the views) or of other images. Unreadable frames are left to
+// the source, which names them and goes on.
+void check_json_view(View& view, const std::string& rig_file) {
+  const io::OpenPoseSequence sequence = io::read_openpose_folder(view.path);
+  view.frames = static_cast<std::int64_t>(sequence.frames.size());
+  float max_x = 0.0f, max_y = 0.0f;
+  for (const People2D& frame : sequence.frames) {
+    for (const Person2D& p : frame.people) {
+      for (const Keypoint2D& k : p.joints) {
+        if (!(k.confidence > 0.0f) || !std::isfinite(k.x) || !std::isfinite(k.y)) continue;
+        max_x = std::max(max_x, k.x);
+        max_y = std::max(max_y, k.y);
+      }
+    }
+  }
+  const camera::Camera& c = *view.camera;
+  if (max_x > static_cast<float>(c.width) + 1.0f || max_y > static_cast<float>(c.height) + 1.0f) {
+    std::ostringstream what;
+    what << "the keypoints of " << view.path << " reach (" << max_x << ", " << max_y
+         << ") px, outside camera '" << c.name << "' of " << rig_file << " ("
+         << size_text(c.width, c.height)
+         << "): give the views in the rig's camera order, each from its camera's images";
+    throw InputError(c.name, what.str());
+  }
+}
+
+void check_video_view(View& view, const std::string& rig_file, const Args& args) {
+  video::SourceOptions options;
+  if (args.has("fps")) options.folder_fps = options.fps = args.number("fps");
+  const video::VideoSource source(view.path, options);
+  const camera::Camera& c = *view.camera;
+  if (source.width() != c.width || source.height() != c.height) {
+    throw InputError(c.name, view.path + " is " + size_text(source.width(), source.height()) +
+                                 " but camera '" + c.name + "' of " + rig_file + " is " +
+                                 size_text(c.width, c.height) +
+                                 ": give the views in the rig's camera order, at the calibrated "
+                                 "size");
+  }
+  view.frames = source.frame_count();
+  view.fps = source.fps();
+}
+
+// One view per rig camera, in its order: a camera without a view or a view without a camera is
+// refused, naming it.
+std::vector<View> match_views(const camera::Rig& rig, const std::vector<std::string>& paths,
+                              const std::string& rig_file) {
+  if (paths.size() < rig.cameras.size()) {
+    throw InputError(rig.cameras[paths.size()].name,
+                     "no view for this camera: " + rig_file + " has " +
+                         std::to_string(rig.cameras.size()) + " cameras, " +
+                         std::to_string(paths.size()) +
+                         " views were given; give one view per camera, in the rig's order");
+  }
+  if (paths.size() > rig.cameras.size()) {
+    throw InputError(paths[rig.cameras.size()], "no camera for this view: " + rig_file + " has " +
+                                                    std::to_string(rig.cameras.size()) +
+                                                    " cameras, " + std::to_string(paths.size()) +
+                                                    " views were given");
+  }
+  std::vector<View> views;
+  for (std::size_t i = 0; i < paths.size(); ++i)
+    views.push_back({paths[i], view_kind(paths[i]), &rig.cameras[i]});
+  return views;
+}
+
+std::string quoted(const std::string& text) { return json(text).dump(); }
+
+// The graph of graphs/multiview_json.yaml (and its video form) for these views.
+std::string graph_text(const std::vector<View>& views, const std::string& rig_file,
+                       const fs::path& out, double fps, const std::string& detector) {
+  const std::string rate = json(fps).dump();
+  std::ostringstream g;
+  g << "graph: multiview_reconstruct\nnodes:\n";
+  for (std::size_t i = 0; i < views.size(); ++i) {
+    const View& v = views[i];
+    const std::string camera = quoted(v.camera->name);
+    if (v.kind == ViewKind::openpose_json) {
+      g << "  view_" << i << ": { type: source.openpose_json, params: { path: " << quoted(v.path)
+        << ", fps: " << rate << ", camera: " << camera << " } }\n";
+      continue;
+    }
+    g << "  view_" << i << ": { type: source.video, params: { path: " << quoted(v.path)
+      << ", mode: offline, fps: " << rate << ", camera: " << camera << " } }\n";
+    const DetectorPreset& preset = detector_preset(detector);
+    g << "  detect_" << i << ": { type: " << preset.type << ", params: {";
+    for (std::size_t p = 0; p < preset.params.size(); ++p)
+      g << (p ? ", " : " ") << preset.params[p].first << ": " << quoted(preset.params[p].second);
+    g << " } }\n";
+  }
+  g << "  solve: { type: multiview.reconstruct, params: { rig: " << quoted(rig_file)
+    << ", fps: " << rate << " } }\n"
+    << "  jsonl: { type: sink.jsonl, params: { path: " << quoted((out / "poses.jsonl").string())
+    << " } }\n"
+    << "  bvh: { type: sink.bvh_joints, params: { dir: " << quoted(out.string())
+    << ", fps: " << rate << " } }\nedges:\n";
+  for (std::size_t i = 0; i < views.size(); ++i) {
+    if (views[i].kind == ViewKind::openpose_json) {
+      g << "  - [view_" << i << ".out, solve.view:" << i << "]\n";
+    } else {
+      g << "  - [view_" << i << ".frames, detect_" << i << ".in]\n"
+        << "  - [detect_" << i << ".out, solve.view:" << i << "]\n";
+    }
+  }
+  g << "  - [solve.out, jsonl.in]\n  - [solve.out, bvh.in]\n";
+  return g.str();
+}
+
+}  // namespace
+
+bool asks_for_multiview(int argc, char** argv) {
+  for (int i = 0; i < argc; ++i) {
+    const std::string_view arg = argv[i];
+    if (arg == "--calibration" || arg.starts_with("--calibration=")) return true;
+  }
+  return false;
+}
+
+int reconstruct_multiview_command(int argc, char** argv) {
+  Args args(
+      "mocap reconstruct --calibration RIG VIEW1 VIEW2 ... --out DIR [--fps F] [--force]",
+      "Reconstructs every person seen by several calibrated cameras, in the rig's world. Each\n"
+      "VIEW is a folder of OpenPose JSON, a video file or a folder of images (people found by the\n"
+      "detector), one per camera of RIG, in the rig's order. Writes into DIR: poses.jsonl (one "
+      "line\n"
+      "per frame set: per person the track id and the 15 joints, metres, under joints_world in\n"
+      "the rig's world), person_<id>.bvh per person (a humanoid skeleton with the person's bone\n"
+      "lengths, y up, the floor at y = 0: the rig's floor, else the plane through its origin\n"
+      "across the cameras' up axis, e.g. z = 0 for Pose2Sim) and summary.json. People seen by one\n"
+      "camera only are dropped and counted. A view's unreadable frames are named and the others\n"
+      "go on; views of different lengths go on with the views left (counted as missing).\n"
+      "DIR holding an earlier run's output is refused unless --force (as without --calibration).");
+  args.positional("VIEW", "one per rig camera: OpenPose JSON folder, video file or image folder",
+                  true)
+      .option("calibration", "RIG",
+              "the rig: Pose2Sim/anipose TOML or OpenCV YAML (docs/cameras.md)")
+      .option("out", "DIR", "output folder (created)")
+      .flag("force", "replace an earlier run's output in DIR")
+      .option("fps", "N",
+              "frame rate of OpenPose JSON and image folders (30 when absent); videos have their "
+              "own",
+              std::nullopt, Range::between(0.1, 1000.0))
+      .option("detector", "NAME",
+              "videos and image folders: how people are found, one of " + detector_names(),
+              std::string(kFileDetector))
+      .option("set", "NODE.PARAM=VALUE",
+              "override a node parameter of the graph (e.g. solve.volume=x0,y0,z0,x1,y1,z1)",
+              std::nullopt, true)
+      .flag("quiet", "do not print statistics");
+  int code = 0;
+  if (!args.parse(argc, argv, code)) return code;
+  if (!args.has("out")) throw InputError("--out", "required: the output folder");
+  if (!args.has("calibration")) throw InputError("--calibration", "required: the rig file");
+  const std::string rig_file = args.get("calibration");
+  const fs::path out = args.get("out");
+
+  // Everything that can be checked before DIR is touched.
+  const camera::Rig rig = camera::read_rig(rig_file);
+  if (const std::string problem = camera::rig_problem(rig); !problem.empty())
+    throw InputError(rig_file, problem);
+  std::vector<View> views = match_views(rig, args.positionals(), rig_file);
+  std::vector<NamedPath> inputs = {{"--calibration", rig_file}};
+  for (const View& v : views) inputs.push_back({"VIEW", v.path});
+  refuse_output_over_inputs({"--out", out.string()}, inputs);
+  for (const char* name : {"poses.jsonl", "summary.json"})
+    refuse_output_over_inputs({"--out", (out / name).string()}, inputs);
+  double fps = args.has("fps") ? args.number("fps") : 0.0;
+  std::int64_t frames = 0;
+  for (View& v : views) {
+    if (v.kind == ViewKind::openpose_json)
+      check_json_view(v, rig_file);
+    else
+      check_video_view(v, rig_file, args);
+    if (fps <= 0.0 && v.fps > 0.0) fps = v.fps;
+    frames = std::max(frames, v.frames);
+  }
+  if (fps <= 0.0) fps = 30.0;
+  std::string floor_how;
+  (void)multiview::rig_floor(rig, &floor_how);
+
+  graph::load_plugins_from_environment();
+  graph::GraphSpec spec = graph::parse_graph_text(
+      graph_text(views, rig_file, out, fps, args.get("detector")), "mocap reconstruct");
+  graph::apply_overrides(spec, args.all("set"));
+  check_detector_model(spec);
+  const graph::ResolvedGraph resolved = graph::resolve(std::move(spec));
+  graph::RunOptions options;
+  options.single_process = true;
+  check_ports_free(resolved, options);
+  EarlierOutput earlier = EarlierOutput::prepare(out, args.has("force"));
+
+  const auto started = std::chrono::steady_clock::now();
+  ProgressBar bar(!args.has("quiet") && isatty(STDERR_FILENO) != 0);
+  const ProgressCallback progress = [&](const graph::GraphStats& stats) {
+    for (const auto& n : stats.nodes) {
+      if (n.type == "sink.jsonl" && frames > 0)
+        bar.update("reconstruct", static_cast<double>(n.in) / static_cast<double>(frames));
+    }
+  };
+  graph::RunResult result;
+  try {
+    result = run_graph_here(resolved, options, "mocap reconstruct", progress);
+  } catch (...) {
+    std::vector<fs::path> files = reconstruct_outputs_in(out);
+    std::erase_if(files, [](const fs::path& f) { return f.filename() == "summary.json"; });
+    earlier.settle(!files.empty());
+    throw;
+  }
+  bar.finish();
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  if (!args.has("quiet")) std::cerr << graph::format_stats_table(result.stats);
+
+  std::vector<fs::path> files = reconstruct_outputs_in(out);
+  std::erase_if(files, [](const fs::path& f) { return f.filename() == "summary.json"; });
+  const WrittenOutputs written = classify_outputs(files);
+  const bool wrote_output = !files.empty();
+  const bool earlier_put_back = earlier.count() > 0 && !wrote_output;
+  if (const std::string note = earlier.settle(wrote_output); !note.empty())
+    std::cerr << "mocap reconstruct: " << note << "\n";
+  const std::string outcome = !result.ok       ? "failed: " + result.error
+                              : result.stopped ? std::string("interrupted")
+                                               : std::string();
+  if (earlier_put_back || (!wrote_output && !outcome.empty())) {
+    if (!outcome.empty()) std::cerr << "mocap reconstruct: " << outcome << "\n";
+    std::cerr << "mocap reconstruct: nothing was written into " << out.string() << "\n";
+    return !result.ok ? 1 : result.stopped ? 130 : 0;
+  }
+  json summary = summarize_output(out / "poses.jsonl");
+  summary["calibration"] = rig_file;
+  json view_list = json::array();
+  for (const View& v : views) {
+    view_list.push_back({{"camera", v.camera->name},
+                         {"path", v.path},
+                         {"kind", v.kind == ViewKind::video ? "video" : "openpose_json"},
+                         {"frames", v.frames}});
+  }
+  summary["views"] = view_list;
+  summary["fps"] = fps;
+  summary["floor"] = floor_how;
+  summary["seconds"] = seconds;
+  const double frames_per_second = seconds > 0 ? summary["frames"].get<double>() / seconds : 0.0;
+  summary["frames_per_second"] = frames_per_second;
+  summary["nodes"] = node_latency(result.stats);
+  summary["completed"] = result.ok && !result.stopped;
+  summary["interrupted"] = result.stopped;
+  if (!result.ok) summary["error"] = result.error;
+  summary["files"] = files_json(files);
+  summary["git_commit"] = git_commit();
+  const fs::path summary_file = out / "summary.json";
+  write_file_atomically(summary_file, json_text(summary, 2) + "\n");
+
+  print_written(out, written, summary, frames_per_second);
+  std::cout << "wrote " << summary_file.string() << "\n";
+  if (!outcome.empty()) {
+    std::cerr << "mocap reconstruct: " << outcome << "\n"
+              << "mocap reconstruct: " << incomplete_note(written, summary, frames) << "\n";
+  }
+  if (!result.ok) return 1;
+  return result.stopped ? 130 : 0;
+}
+
+}  // namespace mocap::cli

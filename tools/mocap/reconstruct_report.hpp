@@ -1,0 +1,38 @@
+#pragma once
+// What the monocular and the multi-view `mocap reconstruct` share (reconstruct_command.cpp): the
+// checks before a graph runs and the report of what it wrote.
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "graph/graph_spec.hpp"
+#include "graph/stats.hpp"
+#include "reconstruct_outputs.hpp"
+
+namespace mocap::cli {
+
+// A graph with detector nodes on the cached models: a missing model is reported before anything
+// runs, naming the command that fetches it.
+void check_detector_model(const graph::GraphSpec& spec);
+
+// What the run produced, read back from poses.jsonl: frames, people, track lengths.
+nlohmann::json summarize_output(const std::filesystem::path& jsonl);
+// The files with their sizes, for summary.json.
+nlohmann::json files_json(const std::vector<std::filesystem::path>& files);
+// "wrote ..." lines for the files of this run.
+void print_written(const std::filesystem::path& out, const WrittenOutputs& written,
+                   const nlohmann::json& summary, double frames_per_second);
+// For a run that did not complete but wrote something: what it kept, and what it did not write.
+std::string incomplete_note(const WrittenOutputs& written, const nlohmann::json& summary,
+                            std::int64_t input_frames);
+// Per node: in, out, drops, latency.
+nlohmann::json node_latency(const graph::GraphStats& stats);
+
+// `mocap reconstruct --calibration RIG VIEW...` (reconstruct_multiview.cpp).
+bool asks_for_multiview(int argc, char** argv);
+int reconstruct_multiview_command(int argc, char** argv);
+
+}  // namespace mocap::cli
