@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <numbers>
 #include <stdexcept>
@@ -352,6 +353,14 @@ void SceneScorer::add(const SceneFrame& frame, const multiview::FrameResult& res
     }
   }
   for (std::size_t t = 0; t < people; ++t) score_.person_frames += views_seen[t] >= 2;
+  if (keep_tracks_) {
+    Body none;
+    none.fill(glm::vec3(std::numeric_limits<float>::quiet_NaN()));
+    for (std::size_t t = 0; t < people && t < tracks_.size(); ++t) {
+      tracks_[t].truth.push_back(frame.truth[t]);
+      tracks_[t].reconstructed.push_back(none);
+    }
+  }
   std::vector<char> claimed(people, 0);
   for (std::size_t p = 0; p < result.people.size(); ++p) {
     std::map<int, int> votes;
@@ -382,6 +391,8 @@ void SceneScorer::add(const SceneFrame& frame, const multiview::FrameResult& res
     const std::span<const multiview::TriangulatedPoint> body = result.body_of(p);
     for (int j = 0; j < kBodyJoints; ++j) {
       if (!body[j].valid()) continue;
+      if (keep_tracks_)
+        tracks_[static_cast<std::size_t>(majority)].reconstructed.back()[j] = body[j].position;
       score_.joint_error_sum += glm::distance(body[j].position, truth[j]);
       ++score_.joints;
     }

@@ -138,15 +138,29 @@ struct SceneScore {
   }
 };
 
+// One truth person over the scene's frames (SceneScorer with keep_tracks): the truth where the
+// person is in the room, and the joints of the reconstruction matched with them (NaN where none
+// was, or a joint was not triangulated), for metrics over time (acceleration, bone lengths).
+struct ScenePersonTrack {
+  std::vector<std::optional<Body>> truth;
+  std::vector<Body> reconstructed;
+};
+
 class SceneScorer {
  public:
-  explicit SceneScorer(int people) : last_id_(static_cast<std::size_t>(people), -1) {}
+  explicit SceneScorer(int people, bool keep_tracks = false)
+      : last_id_(static_cast<std::size_t>(people), -1),
+        keep_tracks_(keep_tracks),
+        tracks_(keep_tracks ? static_cast<std::size_t>(people) : 0u) {}
   void add(const SceneFrame& frame, const multiview::FrameResult& result);
   const SceneScore& score() const { return score_; }
+  const std::vector<ScenePersonTrack>& tracks() const { return tracks_; }
 
  private:
   SceneScore score_;
   std::vector<int> last_id_;
+  bool keep_tracks_ = false;
+  std::vector<ScenePersonTrack> tracks_;  // per truth person, with keep_tracks
 };
 
 }  // namespace mocap::eval

@@ -37,6 +37,12 @@ bool to_double(std::string_view s, double& v) {
   return ec == std::errc() && ptr == s.data() + s.size();
 }
 
+bool only_blank_after(const std::vector<std::string_view>& lines, std::size_t from) {
+  for (std::size_t l = from; l < lines.size(); ++l)
+    if (!trim(lines[l]).empty()) return false;
+  return true;
+}
+
 }  // namespace
 
 std::optional<std::size_t> TrcFile::marker(std::string_view name) const {
@@ -98,6 +104,9 @@ TrcFile parse_trc(std::string_view text, const std::string& file) {
   constexpr float nan = std::numeric_limits<float>::quiet_NaN();
   for (std::size_t l = 5; l < lines.size(); ++l) {
     if (trim(lines[l]).empty()) continue;
+    if (num_frames >= 0 && static_cast<long>(out.frames.size()) == num_frames &&
+        only_blank_after(lines, l + 1))
+      break;  // one row beyond the count, last: a streaming writer killed before counting it
     const auto cells = split_tabs(lines[l]);
     const std::size_t wanted = 2 + 3 * out.markers.size();
     if (cells.size() < wanted)

@@ -3,7 +3,8 @@
 // (../shared/data/eval/pose2sim_demo/README.md): line 1 `PathFileType`, lines 2-3 a header table
 // (DataRate, ..., NumFrames, NumMarkers, Units, ...), line 4 `Frame#`, `Time` and the marker
 // names, line 5 the X1 Y1 Z1 ... labels, data from line 6. Units are converted to metres; axes are
-// kept as in the file.
+// kept as in the file. One last row beyond NumFrames is ignored: a writer that keeps the count
+// right after every row (io/trc_writer.hpp) leaves it when killed between the row and its count.
 
 #include <filesystem>
 #include <optional>

@@ -1,4 +1,5 @@
-// `mocap eval virtual | humaneva`: the evaluation protocols of ../shared/docs/EVALUATION.md.
+// `mocap eval virtual | humaneva | ... | multiview | pose2sim`: the evaluation protocols of
+// ../shared/docs/EVALUATION.md.
 
 #include <atomic>
 #include <chrono>
@@ -336,6 +337,10 @@ int eval_command(int argc, char** argv) {
        humaneva_fit_command},
       {"crossview", "cross-view consistency (paper 5.3): Pose2Sim 4 views, HumanEva-I 3 views",
        crossview_eval_command},
+      {"multiview", "multi-view virtual protocol on held-out CMU clips: baseline, ours, + tracking",
+       multiview_eval_command},
+      {"pose2sim", "Pose2Sim's demo: our multi-view 3D against its triangulated TRC",
+       pose2sim_eval_command},
   };
   return run_subcommand("eval", kSubcommands, argc, argv);
 }

@@ -1,0 +1,303 @@
+#include "eval/pose2sim_multiview.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <iomanip>
+#include <sstream>
+
+#include <glm/geometric.hpp>
+
+#include "camera/rig_file.hpp"
+#include "core/input_error.hpp"
+#include "core/keypoint_layout.hpp"
+#include "eval/pose2sim_trial.hpp"
+#include "io/openpose_json.hpp"
+#include "io/trc.hpp"
+#include "multiview/reconstructor.hpp"
+
+namespace mocap::eval {
+namespace {
+
+constexpr float kLikelihoodThreshold = 0.3f;  // Pose2Sim's, for the "all views" errors
+
+// The TRC's markers are BODY_25B keypoints of the same names, but for these two.
+int body25b_keypoint(const std::string& marker) {
+  if (marker == "Neck") return 17;  // UpperNeck
+  if (marker == "Head") return 18;  // HeadTop
+  const KeypointLayout& l = layout(LayoutId::body25b);
+  for (std::size_t k = 0; k < l.keypoints.size(); ++k)
+    if (l.keypoints[k] == marker) return static_cast<int>(k);
+  return -1;
+}
+
+glm::dmat3 intrinsic_matrix(const camera::Camera& c) {
+  const std::array<double, 9> rows = c.matrix();
+  glm::dmat3 k(1.0);  // GLM is column-major, Camera::matrix() row-major
+  for (int r = 0; r < 3; ++r)
+    for (int col = 0; col < 3; ++col) k[col][r] = rows[static_cast<std::size_t>(3 * r + col)];
+  return k;
+}
+
+std::filesystem::path raw_trc(const std::filesystem::path& trial) {
+  const std::filesystem::path folder = trial / "pose-3d";
+  std::error_code error;
+  for (const auto& entry : std::filesystem::directory_iterator(folder, error)) {
+    const std::string name = entry.path().filename().string();
+    if (entry.path().extension() == ".trc" && name.find("_filt") == std::string::npos)
+      return entry.path();
+  }
+  throw InputError(folder.string(), "no raw triangulation TRC (*.trc without _filt) here");
+}
+
+struct Demo {
+  std::vector<camera::Camera> cameras;
+  std::vector<multiview::ViewGeometry> views;
+  std::vector<io::OpenPoseSequence> json;  // per camera, in folder name order
+  io::TrcFile trc;
+  std::size_t frames = 0;
+
+  // Frame i's detections, undistorted with each camera's lens.
+  void observations(std::size_t i, multiview::FrameObservations& out) const {
+    out.reset(static_cast<int>(views.size()), 25);
+    std::vector<std::array<float, 2>> pixels;
+    for (std::size_t c = 0; c < views.size(); ++c) {
+      if (i >= json[c].frames.size()) continue;
+      for (const Person2D& person : json[c].frames[i].people) {
+        const std::span<float> xyc = out.add_person(static_cast<int>(c));
+        pixels.clear();
+        for (const Keypoint2D& k : person.joints) pixels.push_back({k.x, k.y});
+        cameras[c].undistort_pixels(pixels);
+        for (std::size_t k = 0; k < person.joints.size() && k < 25; ++k) {
+          xyc[3 * k] = pixels[k][0];
+          xyc[3 * k + 1] = pixels[k][1];
+          xyc[3 * k + 2] = person.joints[k].confidence;
+        }
+      }
+    }
+  }
+
+  // Mean distance of `world`'s projection to keypoint k of the participant's confident
+  // detections (raw pixels, so through the lens); NaN without one.
+  float error_all_px(std::size_t i, std::span<const int> detections, int k,
+                     const glm::dvec3& world) const {
+    double sum = 0.0;
+    int n = 0;
+    for (std::size_t c = 0; c < detections.size(); ++c) {
+      if (detections[c] < 0) continue;
+      const Keypoint2D& kp =
+          json[c].frames[i].people[static_cast<std::size_t>(detections[c])].joints[k];
+      if (kp.confidence < kLikelihoodThreshold) continue;
+      const glm::dvec2 p = cameras[c].project(world);
+      if (!std::isfinite(p.x)) continue;
+      sum += glm::distance(p, glm::dvec2(kp.x, kp.y));
+      ++n;
+    }
+    return n > 0 ? static_cast<float>(sum / n) : std::nanf("");
+  }
+};
+
+Demo load(const std::filesystem::path& trial, const std::filesystem::path& calibration,
+          std::size_t max_frames) {
+  Demo d;
+  d.cameras = camera::read_rig(calibration).cameras;
+  for (const auto& c : d.cameras)
+    d.views.push_back(
+        multiview::ViewGeometry::from_krt(intrinsic_matrix(c), c.rotation, c.translation));
+  std::vector<std::filesystem::path> folders;
+  std::error_code error;
+  for (const auto& entry : std::filesystem::directory_iterator(trial / "pose", error))
+    if (entry.is_directory() && entry.path().filename().string().ends_with("_json"))
+      folders.push_back(entry.path());
+  if (error) throw InputError((trial / "pose").string(), "cannot list: " + error.message());
+  std::sort(folders.begin(), folders.end());
+  if (folders.size() != d.cameras.size())
+    throw InputError((trial / "pose").string(),
+                     std::to_string(folders.size()) + " camXX_json folders for " +
+                         std::to_string(d.cameras.size()) + " cameras in " + calibration.string());
+  io::OpenPoseOptions options;
+  options.body25 = io::Body25Choice::body25b;
+  for (const auto& f : folders) d.json.push_back(io::read_openpose_folder(f, options));
+  d.trc = io::read_trc(raw_trc(trial));
+  d.frames = d.trc.frames.size();
+  if (max_frames > 0) d.frames = std::min(d.frames, max_frames);
+  return d;
+}
+
+Pose2SimRun run(const Demo& demo, std::string name, const multiview::ReconstructionOptions& o) {
+  multiview::ReconstructionOptions options = o;
+  options.tracker.fps = static_cast<float>(demo.trc.rate);
+  multiview::MultiViewReconstructor reconstructor(
+      demo.views, multiview::KeypointSet::of(layout(LayoutId::body25b)), options);
+  Pose2SimRun out;
+  out.name = std::move(name);
+  out.markers.resize(demo.trc.markers.size());
+  out.limb_lengths.resize(pose2sim_limbs().size());
+  const auto rhip = demo.trc.marker("RHip"), lhip = demo.trc.marker("LHip");
+  if (!rhip || !lhip) throw InputError(demo.trc.path, "no RHip and LHip markers");
+  multiview::FrameObservations obs;
+  for (std::size_t i = 0; i < demo.frames; ++i) {
+    demo.observations(i, obs);
+    const multiview::FrameResult& r = reconstructor.process(obs, static_cast<std::int64_t>(i));
+    out.outside_people += r.outside_people;
+    const glm::vec3 hips(
+        0.5 * (trc_to_world(demo.trc.frames[i][*rhip]) + trc_to_world(demo.trc.frames[i][*lhip])));
+    int participant = -1;
+    float nearest = 0.5f;
+    for (std::size_t p = 0; p < r.people.size(); ++p) {
+      const float d = glm::distance(multiview::body_centre(r.body_of(p)), hips);
+      if (d < nearest) {
+        nearest = d;
+        participant = static_cast<int>(p);
+      }
+    }
+    out.other_people += static_cast<int>(r.people.size()) - (participant >= 0);
+    if (participant < 0) continue;
+    ++out.frames_with_participant;
+    const auto detections = r.detections_of(static_cast<std::size_t>(participant));
+    const auto keypoints = r.keypoints_of(static_cast<std::size_t>(participant));
+    for (std::size_t l = 0; l < pose2sim_limbs().size(); ++l) {
+      const auto& a = keypoints[body25b_keypoint(pose2sim_limbs()[l].first)];
+      const auto& b = keypoints[body25b_keypoint(pose2sim_limbs()[l].second)];
+      if (a.valid() && b.valid())
+        out.limb_lengths[l].push_back(glm::distance(a.position, b.position));
+    }
+    for (std::size_t m = 0; m < demo.trc.markers.size(); ++m) {
+      const int k = body25b_keypoint(demo.trc.markers[m]);
+      if (k < 0) continue;
+      const glm::dvec3 theirs = trc_to_world(demo.trc.frames[i][m]);
+      Pose2SimMarkerStats& s = out.markers[m];
+      if (!keypoints[k].valid()) continue;
+      s.trc_error_all_px.push_back(demo.error_all_px(i, detections, k, theirs));
+      s.distance_m.push_back(glm::distance(keypoints[k].position, glm::vec3(theirs)));
+      s.views.push_back(static_cast<float>(keypoints[k].view_count()));
+      s.error_used_px.push_back(keypoints[k].error_px);
+      s.error_all_px.push_back(
+          demo.error_all_px(i, detections, k, glm::dvec3(keypoints[k].position)));
+    }
+  }
+  return out;
+}
+
+std::string fixed(double v, int digits) {
+  std::ostringstream s;
+  s << std::fixed << std::setprecision(digits) << v;
+  return s.str();
+}
+
+std::vector<float> finite_only(const std::vector<float>& v) {
+  std::vector<float> out;
+  for (float x : v)
+    if (std::isfinite(x)) out.push_back(x);
+  return out;
+}
+
+}  // namespace
+
+float median_of(std::vector<float> v) {
+  v = finite_only(v);
+  if (v.empty()) return std::nanf("");
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+  return v[v.size() / 2];
+}
+
+float mean_of(const std::vector<float>& v) {
+  double s = 0.0;
+  std::size_t n = 0;
+  for (const float x : v)
+    if (std::isfinite(x)) s += x, ++n;
+  return n == 0 ? std::nanf("") : static_cast<float>(s / static_cast<double>(n));
+}
+
+float limb_std_m(const std::vector<std::vector<float>>& lengths) {
+  double sum = 0.0;
+  int limbs = 0;
+  for (const auto& l : lengths) {
+    if (l.size() < 2) continue;
+    const float m = mean_of(l);
+    double var = 0.0;
+    for (const float x : l) var += (x - m) * (x - m);
+    sum += std::sqrt(var / static_cast<double>(l.size()));
+    ++limbs;
+  }
+  return limbs > 0 ? static_cast<float>(sum / limbs) : std::nanf("");
+}
+
+const std::vector<std::pair<std::string, std::string>>& pose2sim_limbs() {
+  static const std::vector<std::pair<std::string, std::string>> limbs = {
+      {"RHip", "RKnee"},       {"RKnee", "RAnkle"},  {"LHip", "LKnee"},       {"LKnee", "LAnkle"},
+      {"RShoulder", "RElbow"}, {"RElbow", "RWrist"}, {"LShoulder", "LElbow"}, {"LElbow", "LWrist"}};
+  return limbs;
+}
+
+Pose2SimComparison compare_with_pose2sim(const std::filesystem::path& trial,
+                                         const std::filesystem::path& calibration,
+                                         std::size_t max_frames) {
+  const Demo demo = load(trial, calibration, max_frames);
+  Pose2SimComparison c;
+  c.trial = trial.string();
+  c.calibration = calibration.string();
+  c.reference = demo.trc.path;
+  c.frames = demo.frames;
+  c.markers = demo.trc.markers;
+  c.trc_limb_lengths.resize(pose2sim_limbs().size());
+  for (std::size_t i = 0; i < demo.frames; ++i) {
+    for (std::size_t l = 0; l < pose2sim_limbs().size(); ++l) {
+      const auto a = demo.trc.marker(pose2sim_limbs()[l].first);
+      const auto b = demo.trc.marker(pose2sim_limbs()[l].second);
+      if (a && b)
+        c.trc_limb_lengths[l].push_back(
+            glm::distance(demo.trc.frames[i][*a], demo.trc.frames[i][*b]));
+    }
+  }
+  c.runs.push_back(run(demo, "ours", {}));
+  multiview::ReconstructionOptions no_prior;
+  no_prior.tracker.prior = false;
+  c.runs.push_back(run(demo, "ours without the tracks' prior", no_prior));
+  multiview::ReconstructionOptions rule;
+  rule.triangulation.method = multiview::TriangulationMethod::pose2sim;
+  c.runs.push_back(run(demo, "Pose2Sim's rule (ours)", rule));
+  return c;
+}
+
+std::string pose2sim_table(const Pose2SimComparison& c) {
+  std::ostringstream s;
+  s << c.frames << " frames of " << c.trial << " against " << c.reference << "\n\n";
+  s << "| marker | reconstruction | − TRC median mm | mean mm | views used | error px (views "
+       "used) | error px (all confident views) | TRC's error px (same views) |\n"
+    << "|---|---|---:|---:|---:|---:|---:|---:|\n";
+  const auto row = [&](const std::string& marker, const Pose2SimRun& r,
+                       const Pose2SimMarkerStats& m) {
+    s << "| " << marker << " | " << r.name << " | " << fixed(1000 * median_of(m.distance_m), 1)
+      << " | " << fixed(1000 * mean_of(m.distance_m), 1) << " | " << fixed(mean_of(m.views), 2)
+      << " | " << fixed(mean_of(m.error_used_px), 1) << " | " << fixed(mean_of(m.error_all_px), 1)
+      << " | " << fixed(mean_of(m.trc_error_all_px), 1) << " |\n";
+  };
+  for (std::size_t m = 0; m < c.markers.size(); ++m)
+    for (const Pose2SimRun& r : c.runs) row(c.markers[m], r, r.markers[m]);
+  for (const Pose2SimRun& r : c.runs) {
+    Pose2SimMarkerStats all;
+    for (const auto& m : r.markers) {
+      all.distance_m.insert(all.distance_m.end(), m.distance_m.begin(), m.distance_m.end());
+      all.views.insert(all.views.end(), m.views.begin(), m.views.end());
+      all.error_used_px.insert(all.error_used_px.end(), m.error_used_px.begin(),
+                               m.error_used_px.end());
+      all.error_all_px.insert(all.error_all_px.end(), m.error_all_px.begin(), m.error_all_px.end());
+      all.trc_error_all_px.insert(all.trc_error_all_px.end(), m.trc_error_all_px.begin(),
+                                  m.trc_error_all_px.end());
+    }
+    row("**all**", r, all);
+  }
+  s << "\nLimb length std over the trial (mean of " << pose2sim_limbs().size() << " limbs), mm: ";
+  for (const Pose2SimRun& r : c.runs)
+    s << r.name << " " << fixed(1000 * limb_std_m(r.limb_lengths), 1) << ", ";
+  s << "Pose2Sim's TRC " << fixed(1000 * limb_std_m(c.trc_limb_lengths), 1) << "\n";
+  s << "\nFrames with the participant: ";
+  for (const Pose2SimRun& r : c.runs)
+    s << r.name << " " << r.frames_with_participant << " (other people reported " << r.other_people
+      << "); ";
+  s << "\nSkeleton fitting: n/a (the multi-view fit is not available in this build)\n";
+  return s.str();
+}
+
+}  // namespace mocap::eval

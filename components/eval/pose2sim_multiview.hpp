@@ -1,0 +1,66 @@
+#pragma once
+// Issue 19 report 1: our multi-view reconstruction of Pose2Sim's demo (../shared/data/eval/
+// pose2sim_demo: 4 calibrated views, OpenPose BODY_25B JSON) against Pose2Sim's own triangulated
+// TRC of the same JSON and calibration, marker by marker (the TRC's markers are BODY_25B
+// keypoints of the same names; Neck is keypoint 17, Head 18).
+//
+// Three reconstructions in one run, each MultiViewReconstructor over the BODY_25B keypoints,
+// undistorted with each camera's lens: ours (association, robust triangulation, tracking with its
+// prior), ours without the tracks' prior (per-frame geometry), and our implementation of Pose2Sim's
+// rule (confidence-weighted DLT, views dropped until the mean reprojection error is under 15 px).
+// The participant in each frame is the person whose mid-hip is nearest the TRC's (within 0.5 m).
+//
+// Reprojection errors, pixels, per marker: "used" is the triangulator's mean over the views it
+// kept; "all" projects a 3D point (ours, or the TRC's marker) through each camera (with its lens)
+// onto the participant's detections of confidence >= 0.3 (Pose2Sim's likelihood threshold) and
+// averages over them, the same footing for both.
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace mocap::eval {
+
+struct Pose2SimMarkerStats {
+  std::vector<float> distance_m;        // ours − TRC per frame
+  std::vector<float> views;             // views used per frame
+  std::vector<float> error_used_px;     // triangulator's error on the views used
+  std::vector<float> error_all_px;      // ours projected onto every confident detection
+  std::vector<float> trc_error_all_px;  // the TRC's marker, the same way (same frames)
+};
+
+struct Pose2SimRun {
+  std::string name;
+  std::vector<Pose2SimMarkerStats> markers;      // TRC marker order
+  std::vector<std::vector<float>> limb_lengths;  // per limb (pose2sim_limbs()), metres
+  int frames_with_participant = 0;
+  int other_people = 0;
+  int outside_people = 0;
+};
+
+struct Pose2SimComparison {
+  std::string trial, calibration, reference;
+  std::size_t frames = 0;
+  std::vector<std::string> markers;
+  std::vector<std::vector<float>> trc_limb_lengths;
+  std::vector<Pose2SimRun> runs;  // ours, ours without the prior, Pose2Sim's rule
+};
+
+// The eight limbs between TRC markers whose length std is reported.
+const std::vector<std::pair<std::string, std::string>>& pose2sim_limbs();
+
+// Reads `trial` (pose/camXX_json in name order = the calibration's cameras; the raw
+// pose-3d/*_0-*.trc, not the filtered one) and runs the three reconstructions on at most
+// `max_frames` frames (0: all). Throws InputError naming a file that cannot be read.
+Pose2SimComparison compare_with_pose2sim(const std::filesystem::path& trial,
+                                         const std::filesystem::path& calibration,
+                                         std::size_t max_frames = 0);
+
+// Markdown: the per-marker table and the limb-length std line.
+std::string pose2sim_table(const Pose2SimComparison& c);
+
+float median_of(std::vector<float> v);  // NaN when empty
+float mean_of(const std::vector<float>& v);
+float limb_std_m(const std::vector<std::vector<float>>& lengths);  // mean over limbs
+
+}  // namespace mocap::eval
