@@ -97,8 +97,10 @@ void bundle_adjust(BundleProblem& problem, std::vector<double>& errors) {
   for (std::size_t c = 0; c < cameras.size(); ++c) {
     if (!solver.HasParameterBlock(intrinsics[c].data())) continue;
     if (problem.refine_intrinsics) {
-      // k4 k5 k6 (the rational model's denominator) stay as given.
-      solver.SetManifold(intrinsics[c].data(), new ceres::SubsetManifold(kIntrinsics, {9, 10, 11}));
+      // k3 and k4 k5 k6 (the rational model's denominator) stay as given: fitted from a board
+      // that fills little of each image they trade against the focal length.
+      solver.SetManifold(intrinsics[c].data(),
+                         new ceres::SubsetManifold(kIntrinsics, {8, 9, 10, 11}));
     } else {
       solver.SetParameterBlockConstant(intrinsics[c].data());
     }

@@ -240,7 +240,10 @@ Camera intrinsics_from_views(const CameraBoardViews& view, const RigBoardOptions
     pixels.push_back(image_points(b));
   }
   cv::Mat K, D, rvecs, tvecs;
-  rms = cv::calibrateCamera(object, pixels, cv::Size(view.width, view.height), K, D, rvecs, tvecs);
+  // k3 held at zero, as OpenCV advises for ordinary lenses: a board far from the camera fills
+  // little of the image, and a free k3 trades against the focal length.
+  rms = cv::calibrateCamera(object, pixels, cv::Size(view.width, view.height), K, D, rvecs, tvecs,
+                            cv::CALIB_FIX_K3);
   Camera c;
   c.name = view.name;
   c.width = view.width;

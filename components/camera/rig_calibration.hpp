@@ -51,7 +51,7 @@ struct RigBoardOptions {
   std::optional<Rig> intrinsics;
   std::string intrinsics_source = "the intrinsics rig";  // its file, for messages
   int min_intrinsic_views = 4;
-  bool refine_intrinsics = false;  // also adjust fx fy cx cy k1 k2 p1 p2 k3 in the bundle
+  bool refine_intrinsics = false;  // also adjust fx fy cx cy k1 k2 p1 p2 in the bundle
   double outlier_factor = 3.0;     // drop observations with error > factor x median, re-solve
   int outlier_rounds = 2;
   // The frame in which the board lies flat on the floor; -1: the first frame in which any

@@ -77,12 +77,15 @@ std::vector<glm::dvec3> aligned_centres(const std::vector<glm::dvec3>& got,
   return out;
 }
 
-struct Row {
+struct Worst {
   double max_mm = 0, max_deg = 0;
 };
 
-Row run(int cameras, int frames, int width, int height, bool given_intrinsics, bool refine,
-        unsigned seed) {
+void report(const test::VirtualRig& truth, const std::vector<CameraBoardViews>& views,
+            bool given_intrinsics, bool refine, const RigBoardOptions& search);
+
+// One scene, rendered and searched once, calibrated three ways.
+void run(int cameras, int frames, int width, int height, unsigned seed, bool quick) {
   test::VirtualRoom room;
   room.cameras = cameras;
   room.frames = frames;
@@ -95,27 +98,35 @@ Row run(int cameras, int frames, int width, int height, bool given_intrinsics, b
   const auto t0 = std::chrono::steady_clock::now();
   const std::vector<std::string> folders = test::render_virtual_rig(truth, room, dir.path());
   const auto t1 = std::chrono::steady_clock::now();
-  RigBoardOptions options;
-  options.board = room.board;
-  options.refine_intrinsics = refine;
-  if (given_intrinsics) options.intrinsics = Rig{truth.cameras, std::nullopt};
+  RigBoardOptions search;
+  search.board = room.board;
   std::vector<std::string> names;
   for (const Camera& c : truth.cameras) names.push_back(c.name);
-  const std::vector<CameraBoardViews> views = find_rig_board(folders, names, options);
+  const std::vector<CameraBoardViews> views = find_rig_board(folders, names, search);
+  const auto t2 = std::chrono::steady_clock::now();
+  const auto seconds = [](auto a, auto b) { return std::chrono::duration<double>(b - a).count(); };
+  std::printf(
+      "\n## %d cameras, %d frames, %dx%d px (seed %u): render %.1f s, find the board %.1f s\n",
+      cameras, frames, width, height, seed, seconds(t0, t1), seconds(t1, t2));
+  for (int mode = 0; mode < (quick ? 1 : 3); ++mode)
+    report(truth, views, mode == 0, mode == 2, search);
+}
+
+void report(const test::VirtualRig& truth, const std::vector<CameraBoardViews>& views,
+            bool given_intrinsics, bool refine, const RigBoardOptions& search) {
+  RigBoardOptions options = search;
+  options.refine_intrinsics = refine;
+  if (given_intrinsics) options.intrinsics = Rig{truth.cameras, std::nullopt};
   const auto t2 = std::chrono::steady_clock::now();
   const RigCalibration result = calibrate_rig(views, options);
   const auto t3 = std::chrono::steady_clock::now();
-  const auto seconds = [](auto a, auto b) { return std::chrono::duration<double>(b - a).count(); };
+  const double seconds = std::chrono::duration<double>(t3 - t2).count();
 
-  std::printf("\n### %d cameras, %d frames, %dx%d px, intrinsics %s%s (seed %u)\n\n", cameras,
-              frames, width, height,
+  std::printf("\n### intrinsics %s%s\n\n",
               given_intrinsics ? "given (the truth)" : "from each camera's own frames",
-              refine ? ", refined in the bundle" : "", seed);
-  std::printf(
-      "render %.1f s, find the board %.1f s, calibrate %.2f s; %d frames with the board, "
-      "floor frame %d, RMS %.3f px\n\n",
-      seconds(t0, t1), seconds(t1, t2), seconds(t2, t3), result.frames_used, result.floor_frame,
-      result.rms_px);
+              refine ? ", refined in the bundle" : "");
+  std::printf("calibrate %.2f s; %d frames with the board, floor frame %d, RMS %.3f px\n\n",
+              seconds, result.frames_used, result.floor_frame, result.rms_px);
   std::vector<glm::dvec3> got, want;
   for (std::size_t k = 0; k < result.rig.cameras.size(); ++k) {
     got.push_back(result.rig.cameras[k].centre());
@@ -126,7 +137,7 @@ Row run(int cameras, int frames, int width, int height, bool given_intrinsics, b
       "| camera | frames with board (shown) | corners used | dropped | RMS px | corners vs "
       "truth px | position mm | angle deg | position after rigid alignment mm | fx "
       "error %% |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
-  Row row;
+  Worst row;
   for (std::size_t k = 0; k < result.rig.cameras.size(); ++k) {
     const Camera& c = result.rig.cameras[k];
     const Camera& t = truth.cameras[k];
@@ -145,23 +156,25 @@ Row run(int cameras, int frames, int width, int height, bool given_intrinsics, b
   std::printf("| **worst** | | | | | | **%.2f** | **%.3f** | | |\n", row.max_mm, row.max_deg);
 
   if (given_intrinsics && !refine) {
-    // The last camera keeps only the frames no other camera saw the board in.
+    // The last camera loses the frames it shares and sees the board alone in one more frame.
     std::vector<CameraBoardViews> cut = views;
     auto& last = cut.back();
     for (std::size_t f = 0; f < last.boards.size(); ++f)
       for (std::size_t k = 0; k + 1 < cut.size(); ++k)
         if (cut[k].boards[f]) last.boards[f].reset();
+    for (auto& v : cut) v.boards.emplace_back();
+    for (const auto& b : views.back().boards)
+      if (b) last.boards.back() = b;
     try {
       calibrate_rig(cut, options);
       std::printf("\na camera sharing no frame: ACCEPTED (wrong)\n");
     } catch (const InputError& e) {
       std::printf(
-          "\na camera sharing no frame (%s keeps only the frames the others did not see "
-          "the board in): refused: %s\n",
+          "\na camera sharing no frame (%s loses the frames it shares and sees the board "
+          "alone in one more frame): refused: %s\n",
           last.name.c_str(), e.what());
     }
   }
-  return row;
 }
 
 }  // namespace
@@ -183,13 +196,8 @@ int main(int argc, char** argv) {
   const int height = static_cast<int>(args.integer("height"));
   const unsigned seed = static_cast<unsigned>(args.integer("seed"));
   try {
-    run(4, frames, width, height, true, false, seed);
-    if (args.has("quick")) return 0;
-    run(4, frames, width, height, false, false, seed);
-    run(4, frames, width, height, false, true, seed);
-    run(8, frames, width, height, true, false, seed);
-    run(8, frames, width, height, false, false, seed);
-    run(8, frames, width, height, false, true, seed);
+    run(4, frames, width, height, seed, args.has("quick"));
+    if (!args.has("quick")) run(8, frames, width, height, seed, false);
   } catch (const std::exception& e) {
     std::cerr << "mocap-bench-rig-board: " << e.what() << "\n";
     return 1;
