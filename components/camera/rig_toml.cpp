@@ -15,6 +15,7 @@
 #include <system_error>
 #include <vector>
 
+#include "camera/rig_text.hpp"
 #include "core/input_error.hpp"
 
 namespace mocap::camera {
@@ -366,34 +367,16 @@ bool camera_table(const std::string& name) {
 
 // Shortest text that reads back to the same double, always with a decimal point or an exponent
 // (TOML tells floats from integers).
-std::string number_text(double v) {
-  char buffer[64];
-  const auto [end, ec] = std::to_chars(buffer, buffer + sizeof(buffer), v);
-  if (ec != std::errc()) throw std::runtime_error("format_rig_toml: cannot format a number");
-  std::string text(buffer, end);
-  if (text.find_first_of(".eE") == std::string::npos) text += ".0";
-  return text;
-}
-
 std::string array_text(const std::vector<double>& values) {
   std::string out = "[";
   for (const double v : values) {
     out += ' ';
-    out += number_text(v);
+    out += detail::real_text(v);
     out += ',';
   }
   out.back() = ']';  // the last comma, or the '[' of an empty array: "]" then
   if (values.empty()) out = "[]";
   return out;
-}
-
-std::string quoted(const std::string& text) {
-  std::string out = "\"";
-  for (const char c : text) {
-    if (c == '"' || c == '\\') out += '\\';
-    out += c;
-  }
-  return out + "\"";
 }
 
 }  // namespace
@@ -441,7 +424,7 @@ std::string format_rig_toml(const Rig& rig) {
     // Pose2Sim and anipose pass the coefficients to OpenCV: none is written as four zeros.
     const std::vector<double> d = c.distortion.empty() ? std::vector<double>(4, 0.0) : c.distortion;
     out << "\n[cam_" << table << "]\n"
-        << "name = " << quoted(c.name) << "\n"
+        << "name = " << detail::quoted(c.name) << "\n"
         << "size = [ " << c.width << ", " << c.height << "]\n"
         << "matrix = [ " << array_text({c.fx, 0.0, c.cx}) << ", " << array_text({0.0, c.fy, c.cy})
         << ", " << array_text({0.0, 0.0, 1.0}) << "]\n"
@@ -457,7 +440,7 @@ std::string format_rig_toml(const Rig& rig) {
            "up.\n"
         << "[metadata.floor]\n"
         << "normal = " << array_text({f.normal.x, f.normal.y, f.normal.z}) << "\n"
-        << "offset = " << number_text(f.offset) << "\n";
+        << "offset = " << detail::real_text(f.offset) << "\n";
   }
   return out.str();
 }

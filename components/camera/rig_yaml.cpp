@@ -16,6 +16,7 @@
 #include <opencv2/core.hpp>
 
 #include "camera/rig_file.hpp"
+#include "camera/rig_text.hpp"
 #include "core/input_error.hpp"
 #include "core/messages.hpp"
 
@@ -266,17 +267,6 @@ Rig parse(const cv::FileStorage& fs, const std::string& file) {
   return rig;
 }
 
-// Shortest text that reads back to the same double; with a '.' or an exponent, so that OpenCV
-// reads a real.
-std::string number_text(double v) {
-  char buffer[64];
-  const auto [end, ec] = std::to_chars(buffer, buffer + sizeof(buffer), v);
-  if (ec != std::errc()) throw std::runtime_error("format_rig_yaml: cannot format a number");
-  std::string text(buffer, end);
-  if (text.find_first_of(".eE") == std::string::npos) text += ".";
-  return text;
-}
-
 // An OpenCV matrix of doubles, on its own lines after the key.
 std::string matrix_text(int rows, int cols, const std::vector<double>& values) {
   std::string out = "!!opencv-matrix\n";
@@ -287,20 +277,10 @@ std::string matrix_text(int rows, int cols, const std::vector<double>& values) {
   out += indent + "data: [";
   for (std::size_t i = 0; i < values.size(); ++i) {
     out += i == 0 ? " " : ", ";
-    out += number_text(values[i]);
+    out += detail::real_text(values[i]);
   }
   out += " ]\n";
   return out;
-}
-
-// A double-quoted YAML string (camera names have no control characters: camera_problem()).
-std::string quoted(const std::string& text) {
-  std::string out = "\"";
-  for (const char c : text) {
-    if (c == '"' || c == '\\') out += '\\';
-    out += c;
-  }
-  return out + "\"";
 }
 
 }  // namespace
@@ -332,7 +312,7 @@ std::string format_rig_yaml(const Rig& rig) {
     std::vector<double> d = c.distortion;
     if (d.empty()) d.assign(c.fisheye ? 4 : 5, 0.0);
     const glm::dvec3 r = c.rodrigues();
-    out << "   - name: " << quoted(c.name) << "\n"
+    out << "   - name: " << detail::quoted(c.name) << "\n"
         << "     image_width: " << c.width << "\n"
         << "     image_height: " << c.height << "\n"
         << "     camera_matrix: "
@@ -345,7 +325,7 @@ std::string format_rig_yaml(const Rig& rig) {
   if (rig.floor) {
     const GroundPlane& f = *rig.floor;
     out << "ground_normal: " << matrix_text(3, 1, {f.normal.x, f.normal.y, f.normal.z})
-        << "ground_offset: " << number_text(f.offset) << "\n";
+        << "ground_offset: " << detail::real_text(f.offset) << "\n";
   }
   return out.str();
 }

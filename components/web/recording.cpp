@@ -64,8 +64,19 @@ People3D frame_of(const Json& line, std::int64_t number) {
     person.id = p["id"].get<int>();
     const std::string what = "person " + std::to_string(person.id);
     person.positions = joints_of(p.value("joints", Json()), what + " joints");
-    if (const auto abs = p.find("joints_abs"); abs != p.end()) {
-      const auto placed = joints_of(*abs, what + " joints_abs");
+    const auto abs = p.find("joints_abs"), world = p.find("joints_world");
+    if (abs != p.end() && world != p.end())
+      throw std::invalid_argument(what + " has both joints_abs and joints_world");
+    if (world != p.end()) {
+      if (!frame.people.empty() && !frame.frame.is_world())
+        throw std::invalid_argument(what + " has joints_world, the people before it have not");
+      frame.frame = CoordinateFrame::world();
+    } else if (frame.frame.is_world()) {
+      throw std::invalid_argument(what + " has no joints_world, the people before it have");
+    }
+    if (const auto placed_at = world != p.end() ? world : abs; placed_at != p.end()) {
+      const auto placed =
+          joints_of(*placed_at, what + (world != p.end() ? " joints_world" : " joints_abs"));
       person.placed = true;
       person.root.translation = placed[index(Joint::root)] - person.positions[index(Joint::root)];
     }
@@ -85,6 +96,25 @@ People3D frame_of(const Json& line, std::int64_t number) {
   return frame;
 }
 
+// A file is in one frame: people with joints_world (a rig's world) and people with joints_abs
+// (a camera's frame) cannot be drawn together. Remembers the first line of each.
+struct FrameKinds {
+  long world_line = 0, camera_line = 0;
+
+  void add(const People3D& frame, long line) {
+    const bool camera_placed =
+        !frame.frame.is_world() && std::any_of(frame.people.begin(), frame.people.end(),
+                                               [](const Person3D& p) { return p.placed; });
+    if (frame.frame.is_world() && world_line == 0) world_line = line;
+    if (camera_placed && camera_line == 0) camera_line = line;
+    if (world_line > 0 && camera_line > 0)
+      throw std::invalid_argument(
+          world_line > camera_line
+              ? "joints_world, but line " + std::to_string(camera_line) + " has joints_abs"
+              : "joints_abs, but line " + std::to_string(world_line) + " has joints_world");
+  }
+};
+
 }  // namespace
 
 Recording read_poses_jsonl(const std::string& path, double fps) {
@@ -95,13 +125,16 @@ Recording read_poses_jsonl(const std::string& path, double fps) {
 
 Recording parse_poses_jsonl(std::istream& in, const std::string& path, double fps) {
   Recording out;
+  FrameKinds kinds;
   bool times_ok = true;
   std::string text;
   for (long line = 1; std::getline(in, text); ++line) {
     if (text.find_first_not_of(" \t\r") == std::string::npos) continue;
     try {
       const Json json = Json::parse(text);
-      out.frames.push_back(frame_of(json, static_cast<std::int64_t>(out.frames.size())));
+      People3D frame = frame_of(json, static_cast<std::int64_t>(out.frames.size()));
+      kinds.add(frame, line);
+      out.frames.push_back(std::move(frame));
       const auto t = json.find("time");
       const bool has_time = t != json.end() && t->is_number() && std::isfinite(t->get<double>());
       const double time = has_time ? t->get<double>() : 0.0;
@@ -117,6 +150,9 @@ Recording parse_poses_jsonl(std::istream& in, const std::string& path, double fp
   }
   if (in.bad()) throw InputError(path, "read error");
   if (out.frames.empty()) throw InputError(path, "no frames (an empty poses.jsonl)");
+  out.world = kinds.world_line > 0;
+  if (out.world)
+    for (People3D& frame : out.frames) frame.frame = CoordinateFrame::world();
   const double first = out.times.front();
   // Beyond about 292 years nanoseconds do not fit: such a file plays with its frames `fps` apart.
   if (times_ok && !(out.times.back() - first < 9.2e9)) times_ok = false;

@@ -15,9 +15,11 @@ struct Recording {
   std::vector<People3D> frames;
   std::vector<double> times;   // seconds from the first frame, non-decreasing
   bool cut_last_line = false;  // a last line without its newline that did not parse was skipped
+  bool world = false;          // people in a rig's world (joints_world): every frame is world-frame
 };
 
-// Reads poses.jsonl. People with `joints_abs` come back placed (root translation set), `ground`
+// Reads poses.jsonl. People with `joints_abs` (camera frame) or `joints_world` (a rig's world; a
+// file holds one or the other) come back placed (root translation set), `ground`
 // sets the floor. Without usable times (missing, or going backwards) frames are `fps` apart.
 // A last line without its newline that does not parse is what a killed writer leaves (sink.jsonl):
 // it is skipped (cut_last_line). Throws mocap::InputError naming the file and line for anything

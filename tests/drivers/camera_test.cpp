@@ -10,6 +10,7 @@
 
 #include "camera.hpp"
 #include "fake_gv_camera.hpp"
+#include "reconnecting_camera.hpp"
 
 namespace mocap::aravis {
 namespace {
@@ -261,6 +262,46 @@ TEST_F(FakeCameraTest, TheWatchdogLeavesASlowHealthyCameraAlone) {
   const auto frames = grab(camera, 8);
   EXPECT_EQ(frames.size(), 8u);
   EXPECT_FALSE(camera.control_lost()) << camera.loss_reason();
+}
+
+// The camera dies and comes back with the same serial: ReconnectingCamera reports the loss once,
+// reopens it, and counts losses and reconnections across both connections.
+TEST_F(FakeCameraTest, AReconnectingCameraReopensACameraThatComesBack) {
+  const std::string serial = test::unique_serial("RECON");
+  auto fake = std::make_unique<FakeGvCamera>(*program_, serial);
+  CameraSettings s = mono8(serial, 25);
+  s.loss_timeout = 1000ms;
+  ReconnectingCamera camera(s);
+  EXPECT_NE(camera.description().find(serial), std::string::npos) << camera.description();
+  EXPECT_NE(camera.status().find("streaming from"), std::string::npos) << camera.status();
+  const auto frames_until = [&](int wanted, std::chrono::seconds limit, std::string& news) {
+    int frames = 0;
+    const auto end = std::chrono::steady_clock::now() + limit;
+    while (frames < wanted && std::chrono::steady_clock::now() < end) {
+      Poll poll = camera.poll(200ms);
+      if (!poll.news.empty()) news += poll.news + "\n";
+      if (poll.away) std::this_thread::sleep_for(200ms);
+      frames += poll.frame ? 1 : 0;
+    }
+    return frames;
+  };
+  std::string news;
+  ASSERT_EQ(frames_until(3, 15s, news), 3);
+  EXPECT_EQ(news, "");
+  fake.reset();  // killed: the watchdog sees no data, the camera is lost
+  const auto end = std::chrono::steady_clock::now() + 30s;
+  while (camera.totals().losses == 0 && std::chrono::steady_clock::now() < end) {
+    Poll poll = camera.poll(200ms);
+    if (!poll.news.empty()) news += poll.news + "\n";
+  }
+  ASSERT_EQ(camera.totals().losses, 1u) << news;
+  EXPECT_NE(news.find("lost (no data for"), std::string::npos) << news;
+  EXPECT_NE(camera.status().find("[1 lost, 0 reconnects]"), std::string::npos) << camera.status();
+  fake = std::make_unique<FakeGvCamera>(*program_, serial);
+  EXPECT_EQ(frames_until(3, 60s, news), 3) << news;
+  EXPECT_NE(news.find("reconnected to camera '"), std::string::npos) << news;
+  EXPECT_EQ(camera.totals().reconnects, 1u);
+  EXPECT_NE(camera.status().find("[1 lost, 1 reconnects]"), std::string::npos) << camera.status();
 }
 
 }  // namespace

@@ -100,8 +100,17 @@ std::size_t expect_outputs_whole(const fs::path& out, bool killed, const std::st
 // When each run is stopped: SIGINT as soon as it has started (nothing written: no summary either)
 // and once poses.jsonl holds 10 and 40 frames; SIGKILL at 10 and 40 (at the start it would only
 // repeat the SIGINT case without its summary).
+// An AddressSanitizer build runs the whole pipeline 5-10 times slower (these tests took 10 of the
+// sanitizer stage's 20 minutes in CI): there each signal is sent once, mid-run; the Release
+// build tries every moment.
+#if defined(__SANITIZE_ADDRESS__)
+constexpr std::pair<int, std::size_t> kMoments[] = {{SIGINT, 10}, {SIGKILL, 40}};
+constexpr bool kEveryFitOnVideo = false;
+#else
 constexpr std::pair<int, std::size_t> kMoments[] = {
     {SIGINT, 0}, {SIGINT, 10}, {SIGINT, 40}, {SIGKILL, 10}, {SIGKILL, 40}};
+constexpr bool kEveryFitOnVideo = true;
+#endif
 
 class ReconstructKillTest : public ::testing::Test {
  protected:
@@ -198,11 +207,13 @@ TEST_F(ReconstructKillTest, AnInterruptedVideoRunKeepsWholeFiles) {
 }
 
 // The overlay draws every input frame, whatever the fitting (off: as frames come; live: 3 frames
-// late; full: at the end of each window or of the sequence).
+// late; full: at the end of each window or of the sequence). Under AddressSanitizer the video
+// runs with a file's default fit (full) only; the OpenPose JSON runs with every fit.
 TEST_F(ReconstructKillTest, TheOverlayHoldsEveryInputFrameForEveryFit) {
   const std::size_t video_frames = 100;  // more than the 64 frames an overlay once held back
   for (const std::string fit : {"off", "live", "full"}) {
-    if (fs::exists(kVideo) && test::movenet_model_present()) {
+    if (fs::exists(kVideo) && test::movenet_model_present() &&
+        (kEveryFitOnVideo || fit == "full")) {
       const std::string out = dir_->file("overlay_video_" + fit);
       test::Mocap run(
           *dir_, "overlay_video_" + fit,

@@ -101,6 +101,60 @@ TEST(FrameJson, MissingValuesAreNullOrZeroTheCameraAndPlaybackAreSent) {
   EXPECT_NEAR(json["time"].get<double>(), 0.25, 1e-9);
 }
 
+// A z-up world (Pose2Sim's convention) with two level cameras on a ring facing the centre: up comes
+// from the cameras, the floor (not in the rig) is level with the lowest ankle, every camera is
+// sent with its pose (camera -> world rotation, centre) and the people stand where they are.
+TEST(FrameJson, AWorldFrameMessageIsDrawnWithEveryCameraOfItsRig) {
+  camera::Rig rig;
+  for (const double angle : {0.0, 2.0}) {
+    camera::Camera c =
+        camera::Camera::from_fov(1920, 1080, 60.0, "cam_" + std::to_string(int(angle)));
+    const glm::dvec3 centre(4.0 * std::cos(angle), 4.0 * std::sin(angle), 1.6);
+    const glm::dvec3 forward = glm::normalize(glm::dvec3(0.0, 0.0, 1.6) - centre);  // level
+    const glm::dvec3 right = glm::normalize(glm::cross(forward, glm::dvec3(0.0, 0.0, 1.0)));
+    const glm::dvec3 down = glm::cross(forward, right);
+    c.set_pose_from_centre(glm::dmat3(right, down, forward), centre);
+    rig.cameras.push_back(c);
+  }
+  People3D frame;
+  frame.frame = CoordinateFrame::world();
+  Person3D person = test::walking_person(2, 0.3f);
+  for (glm::vec3& p : person.positions) p = {p.x, p.z, -p.y};  // y down -> z up
+  person.placed = true;
+  person.root.translation = {0.5f, -0.2f, 0.95f};
+  frame.people.push_back(person);
+  const Json json = Json::parse(frame_json(frame, rig));
+  EXPECT_TRUE(json["world"].get<bool>());
+  EXPECT_NEAR(json["up"][2].get<double>(), 1.0, 1e-3);
+  ASSERT_EQ(json["cameras"].size(), 2u);
+  const Json& second = json["cameras"][1];
+  EXPECT_EQ(second["name"], "cam_2");
+  EXPECT_NEAR(second["position"][0].get<double>(), 4.0 * std::cos(2.0), 1e-3);
+  EXPECT_NEAR(second["position"][2].get<double>(), 1.6, 1e-3);
+  // The rotation's third column is the camera's optical axis in the world.
+  const glm::dvec3 axis = rig.cameras[1].optical_axis();
+  for (int row = 0; row < 3; ++row)
+    EXPECT_NEAR(second["rotation"][3 * row + 2].get<double>(), axis[row], 1e-5);
+  EXPECT_EQ(json["camera"]["width"], 1920);
+  const glm::vec3 head = joint_mm(json["people"][0], Joint::head) / 1000.0f;
+  EXPECT_NEAR(head.z, 0.95f + 0.72f, 0.002);
+  EXPECT_FALSE(json["ground"]["known"].get<bool>());
+  const float ankle = std::min(person.positions[index(Joint::left_ankle)].z,
+                               person.positions[index(Joint::right_ankle)].z) +
+                      0.95f;
+  EXPECT_NEAR(json["ground"]["offset"].get<double>(), -ankle, 0.002);
+  // A rig with a floor: that floor, known.
+  rig.floor = GroundPlane{{0.0, 0.0, 1.0}, 0.0};
+  const Json with_floor = Json::parse(frame_json(frame, rig));
+  EXPECT_TRUE(with_floor["ground"]["known"].get<bool>());
+  EXPECT_NEAR(with_floor["ground"]["offset"].get<double>(), 0.0, 1e-9);
+  // No rig: up from the people.
+  const Json alone = Json::parse(frame_json(frame, camera::Rig{}));
+  EXPECT_NEAR(alone["up"][2].get<double>(), 1.0, 1e-3);
+  EXPECT_TRUE(alone["cameras"].empty());
+  EXPECT_FALSE(alone["camera"]["known"].get<bool>());
+}
+
 TEST(FrameJson, HelloNamesTheJointsAndTheFourteenBones) {
   const Json json = Json::parse(hello_json("title"));
   EXPECT_EQ(json["type"], "hello");
@@ -160,6 +214,39 @@ TEST(Recording, ReadsJointsPlacementFloorAndTimes) {
   EXPECT_NEAR(p.keypoints[2].confidence, 0.9f, 1e-6);
   EXPECT_EQ(p.keypoints[3].confidence, 0.0f);
   EXPECT_EQ(p.keypoints[3].x, 0.0f);
+}
+
+// poses.jsonl of a multi-view reconstruction: joints_world makes every frame world-frame (empty
+// ones too); one file cannot mix it with joints_abs.
+TEST(Recording, JointsWorldMakeAWorldRecordingAndDoNotMixWithJointsAbs) {
+  TempDir dir;
+  const std::string path = dir.file("world.jsonl");
+  Json joints = Json::object(), world = Json::object();
+  for (int j = 0; j < kBodyJoints; ++j) {
+    joints[std::string(kJointNames[static_cast<std::size_t>(j)])] = {0.0, 0.0, 0.1 * j};
+    world[std::string(kJointNames[static_cast<std::size_t>(j)])] = {2.0, 1.0, 0.9 + 0.1 * j};
+  }
+  const Json empty = {{"frame", 0}, {"people", Json::array()}};
+  Json placed = {{"frame", 1}, {"people", Json::array({{{"id", 7}, {"joints", joints}}})}};
+  placed["people"][0]["joints_world"] = world;
+  test::write_file(path, empty.dump() + "\n" + placed.dump() + "\n");
+  const Recording r = read_poses_jsonl(path);
+  EXPECT_TRUE(r.world);
+  EXPECT_TRUE(r.frames[0].frame.is_world());
+  ASSERT_EQ(r.frames[1].people.size(), 1u);
+  EXPECT_TRUE(r.frames[1].people[0].placed);
+  EXPECT_NEAR(r.frames[1].people[0].root.translation.z, 0.9f, 1e-6);
+  Json abs = placed;
+  abs["people"][0].erase("joints_world");
+  abs["people"][0]["joints_abs"] = world;
+  test::write_file(path, placed.dump() + "\n" + abs.dump() + "\n");
+  try {
+    read_poses_jsonl(path);
+    ADD_FAILURE() << "a file mixing joints_world and joints_abs was read";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(":2:"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("line 1 has joints_world"), std::string::npos) << e.what();
+  }
 }
 
 TEST(Recording, WithoutTimesFramesAreSpacedByTheFrameRate) {

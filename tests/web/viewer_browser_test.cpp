@@ -12,6 +12,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "camera/rig_file.hpp"
 #include "graph/graph_spec.hpp"
 #include "graph/runtime.hpp"
 #include "graph/validation.hpp"
@@ -91,6 +92,60 @@ Json drive_page(const Browser& b, const TempDir& dir, const std::string& url,
   return result;
 }
 
+// Height of a joint over the root of an upright person (metres, up positive).
+double height_of_joint(const std::string& name) {
+  return name == "head"                               ? 0.7
+         : name == "neck"                             ? 0.5
+         : name.find("shoulder") != std::string::npos ? 0.45
+         : name.find("elbow") != std::string::npos    ? 0.2
+         : name.find("wrist") != std::string::npos    ? -0.05
+         : name.find("knee") != std::string::npos     ? -0.45
+         : name.find("ankle") != std::string::npos    ? -0.9
+                                                      : 0.0;
+}
+
+// A multi-view reconstruction's recording: 2 people in a z-up world (as Pose2Sim's), 60 frames, and
+// its rig of 4 level cameras on a 4 m ring at 1.6 m, facing the centre.
+void write_world_recording(const std::string& poses, const std::string& rig_file) {
+  camera::Rig rig;
+  for (int k = 0; k < 4; ++k) {
+    camera::Camera c = camera::Camera::from_fov(1280, 720, 60.0, "cam0" + std::to_string(k + 1));
+    const double angle = 0.4 + k * std::acos(-1.0) / 2.0;
+    const glm::dvec3 centre(4.0 * std::cos(angle), 4.0 * std::sin(angle), 1.6);
+    const glm::dvec3 forward = glm::normalize(glm::dvec3(0.0, 0.0, 1.6) - centre);
+    const glm::dvec3 right = glm::normalize(glm::cross(forward, glm::dvec3(0.0, 0.0, 1.0)));
+    c.set_pose_from_centre(glm::dmat3(right, glm::cross(forward, right), forward), centre);
+    rig.cameras.push_back(c);
+  }
+  rig.floor = GroundPlane{{0.0, 0.0, 1.0}, 0.0};
+  write_file(rig_file, camera::format_rig_toml(rig));
+  std::string text;
+  for (int f = 0; f < 60; ++f) {
+    Json people = Json::array();
+    for (int id : {3, 8}) {
+      const double a = 0.05 * f + id, swing = 0.25 * std::sin(0.3 * f + id);
+      const glm::dvec3 root(1.2 * std::cos(a), 1.2 * std::sin(a), 0.95);
+      Json joints = Json::object(), world = Json::object();
+      for (int j = 0; j < kBodyJoints; ++j) {
+        const std::string name(kJointNames[static_cast<std::size_t>(j)]);
+        const double side = name.rfind("left", 0) == 0    ? 0.15
+                            : name.rfind("right", 0) == 0 ? -0.15
+                                                          : 0.0;
+        const double ahead =
+            name.find("wrist") != std::string::npos || name.find("ankle") != std::string::npos
+                ? (side > 0 ? swing : -swing)
+                : 0.0;
+        const glm::dvec3 p(side, ahead, height_of_joint(name));
+        joints[name] = {p.x, p.y, p.z};
+        world[name] = {p.x + root.x, p.y + root.y, p.z + root.z};
+      }
+      people.push_back({{"id", id}, {"joints", joints}, {"joints_world", world}});
+    }
+    text += Json{{"frame", f}, {"time", f / 25.0}, {"people", people}}.dump() + "\n";
+  }
+  write_file(poses, text);
+}
+
 // A recording of 3 people, one of them placed, with a tilted floor: 120 frames at 25 fps.
 void write_recording(const std::string& path) {
   std::string text;
@@ -156,6 +211,48 @@ TEST(ViewerBrowser, MocapViewPlaysARecordingInChromium) {
   EXPECT_EQ(result.value("people_shown", -1), 3);
   EXPECT_TRUE(fs::exists(artefact("viewer_recording.png")));
   std::cerr << "viewer_test.mjs: " << result.dump() << "\n";
+}
+
+// `mocap view --rig`: people in the rig's world, every camera of the rig drawn where it stands.
+TEST(ViewerBrowser, MocapViewShowsAWorldRecordingWithItsRigsCameras) {
+  MOCAP_REQUIRE_BROWSER(browser);
+  TempDir dir;
+  write_world_recording(dir.file("poses.jsonl"), dir.file("rig.toml"));
+  const int port = free_tcp_port();
+  std::vector<std::string> env;
+  if (const char* npm = std::getenv("MOCAP_NPM_DIR"))
+    env.push_back(std::string("MOCAP_NPM_DIR=") + npm);
+  Mocap view(dir, "view",
+             {"view", dir.file("poses.jsonl"), "--port", std::to_string(port), "--rig",
+              dir.file("rig.toml")},
+             env);
+  const std::string url = "http://127.0.0.1:" + std::to_string(port) + "/";
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+  while (view.out().find(url) == std::string::npos && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  ASSERT_NE(view.out().find("60 frames"), std::string::npos) << view.out() << view.err();
+  const Json result = drive_page(browser, dir, url + "?aa=0",
+                                 {"--frames", "20", "--people", "2", "--cameras", "4",
+                                  "--screenshot", artefact("viewer_world.png").string()});
+  EXPECT_EQ(result.value("cameras_shown", -1), 4);
+  EXPECT_EQ(result.value("people_shown", -1), 2);
+  std::cerr << "viewer_test.mjs: " << result.dump() << "\n";
+}
+
+// A camera's recording is not drawn with a rig, nor a world recording with one camera.
+TEST(ViewerBrowser, MocapViewRefusesARigForACameraRecordingAndACameraForAWorldOne) {
+  TempDir dir;
+  write_world_recording(dir.file("world.jsonl"), dir.file("rig.toml"));
+  write_recording(dir.file("camera.jsonl"));
+  Mocap with_rig(dir, "rig",
+                 {"view", dir.file("camera.jsonl"), "--port", "0", "--rig", dir.file("rig.toml")});
+  EXPECT_EQ(with_rig.wait(30s), std::optional<int>(1));
+  EXPECT_NE(with_rig.err().find("not --rig"), std::string::npos) << with_rig.err();
+  Mocap with_camera(dir, "camera",
+                    {"view", dir.file("world.jsonl"), "--port", "0", "--image-size", "1280x720"});
+  EXPECT_EQ(with_camera.wait(30s), std::optional<int>(1));
+  EXPECT_NE(with_camera.err().find("give the rig with --rig"), std::string::npos)
+      << with_camera.err();
 }
 
 TEST(ViewerBrowser, SinkWebInAGraphStreamsLivePeopleToChromium) {

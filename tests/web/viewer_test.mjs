@@ -1,10 +1,10 @@
 // Drives the viewer page in Debian's chromium (headless, playwright-core from the npm cache):
 //   node viewer_test.mjs --url URL --playwright DIR/node_modules/playwright-core
-//        [--frames N] [--people K] [--screenshot FILE] [--timeline] [--duration S]
+//        [--frames N] [--people K] [--cameras C] [--screenshot FILE] [--timeline] [--duration S]
 // Checks: the page loads without script errors, at least N frames arrive over the WebSocket, the
 // people count shown (#people) is K and matches the frames received, the 3D canvas is not blank
 // (pixels read back: not background, and each person's colour present), and with --timeline that
-// pause and seek reach the server. --duration S then samples the page's frames/s for S seconds.
+// pause and seek reach the server; --cameras C: the page draws C cameras (a rig's, in its world). --duration S then samples the page's frames/s for S seconds.
 // Prints one JSON line with what it measured; exit code 0 when every check passed, 1 otherwise.
 
 import { mkdtempSync, rmSync } from "node:fs";
@@ -21,6 +21,7 @@ for (let i = 2; i < process.argv.length; ++i) {
 }
 const minFrames = Number(args.frames ?? 30);
 const expectedPeople = args.people === undefined ? null : Number(args.people);
+const expectedCameras = args.cameras === undefined ? null : Number(args.cameras);
 const duration = Number(args.duration ?? 0);
 const failures = [];
 const check = (ok, what) => { if (!ok) failures.push(what); return ok; };
@@ -60,7 +61,11 @@ try {
     fps: Number(document.getElementById("fps").textContent),
     status: document.getElementById("status").textContent,
     drawn: window.viewerStats?.drawn ?? 0,
+    cameras: window.viewerStats?.cameras ?? 0,
   }));
+  result.cameras_shown = shown.cameras;
+  if (expectedCameras !== null) check(shown.cameras === expectedCameras,
+                                      `${shown.cameras} cameras drawn, expected ${expectedCameras}`);
   Object.assign(result, { people_shown: shown.people, fps_shown: shown.fps, status: shown.status });
   const last = frames[frames.length - 1];
   result.people_in_stream = last ? last.people.length : null;

@@ -10,6 +10,7 @@
 #include <optional>
 
 #include "camera/camera_file.hpp"
+#include "camera/rig_file.hpp"
 #include "cli_args.hpp"
 #include "commands.hpp"
 #include "core/input_error.hpp"
@@ -58,6 +59,29 @@ void check_keypoints_inside(const web::Recording& recording,
   }
 }
 
+// A recording in a rig's world (joints_world) is drawn with the rig's cameras (--rig; without
+// it, with none); a camera's recording with that camera (--camera, --image-size).
+std::optional<camera::Rig> rig_of(const web::Recording& recording, const std::string& path,
+                                  const Args& args) {
+  if (!recording.world) {
+    if (args.has("rig"))
+      throw InputError(path,
+                       "people in a camera's frame (joints_abs or none), not in a rig's "
+                       "world: give its camera with --camera or --image-size, not --rig");
+    return std::nullopt;
+  }
+  if (args.has("camera") || args.has("image-size"))
+    throw InputError(path,
+                     "people in a rig's world (joints_world): give the rig with --rig, "
+                     "not --camera or --image-size");
+  if (!args.has("rig")) {
+    std::cerr << "mocap view: " << path
+              << ": people in a rig's world; --rig RIG would draw its cameras\n";
+    return camera::Rig{};
+  }
+  return camera::read_rig(args.get("rig"));
+}
+
 int view_recording(const Args& args) {
   const std::string path = args.positionals()[0];
   const web::Recording recording = web::read_poses_jsonl(path, args.number("fps"));
@@ -66,6 +90,7 @@ int view_recording(const Args& args) {
               << ": the last line is cut (the writer was killed while writing it): skipped\n";
   const std::optional<web::ShownCamera> camera = camera_of(args);
   check_keypoints_inside(recording, camera, path, args);
+  const std::optional<camera::Rig> rig = rig_of(recording, path, args);
 
   std::mutex mutex;
   std::condition_variable changed;
@@ -111,8 +136,9 @@ int view_recording(const Args& args) {
       control = false;
       const web::Playback playback{index, player.count(), player.playing(), player.speed(),
                                    player.duration()};
-      server.broadcast(
-          web::frame_json(recording.frames[index], camera, playback, recording.times[index]));
+      const People3D& frame = recording.frames[index];
+      server.broadcast(rig ? web::frame_json(frame, *rig, playback, recording.times[index])
+                           : web::frame_json(frame, camera, playback, recording.times[index]));
     }
     changed.wait_for(lock, 4ms, [&] { return stop || control; });
   }
@@ -212,6 +238,9 @@ int view_command(int argc, char** argv) {
               std::nullopt, Range::image_size())
       .option("hfov", "DEG", "horizontal field of view with --image-size", "60",
               Range::between(1.0, 179.0))
+      .option("rig", "RIG",
+              "rig file (.toml, .yml) of a recording in its world (joints_world, mocap "
+              "reconstruct --calibration): draw every camera where it stands")
       .flag("quiet", "do not print the graph's statistics at the end");
   int exit_code = 0;
   if (!args.parse(argc, argv, exit_code)) return exit_code;

@@ -8,68 +8,12 @@
 #include <fstream>
 #include <vector>
 
+#include "graph/packet_digest.hpp"
 #include "graph/registry.hpp"
 #include "graph/transport.hpp"
 
 namespace mocap::nodes {
 using namespace mocap::graph;
-
-namespace {
-
-// FNV-1a: a small, stable digest; enough to tell two payloads apart in tests.
-class Digest {
- public:
-  void add(const void* data, std::size_t size) {
-    const auto* p = static_cast<const unsigned char*>(data);
-    for (std::size_t i = 0; i < size; ++i) hash_ = (hash_ ^ p[i]) * 1099511628211ULL;
-  }
-  template <class T>
-  void add(const T& value) {
-    add(&value, sizeof value);
-  }
-  std::uint64_t value() const { return hash_; }
-
- private:
-  std::uint64_t hash_ = 14695981039346656037ULL;
-};
-
-std::uint64_t digest(const Packet& packet) {
-  Digest d;
-  if (packet.type == People2D::kTypeName) {
-    const auto& m = static_cast<const People2D&>(*packet.message);
-    d.add(m.layout);
-    d.add(m.camera.data(), m.camera.size());
-    for (const Person2D& p : m.people) {
-      d.add(p.id);
-      d.add(p.box);
-      d.add(p.joints.data(), p.joints.size() * sizeof(Keypoint2D));
-    }
-  } else if (packet.type == People3D::kTypeName) {
-    const auto& m = static_cast<const People3D&>(*packet.message);
-    d.add(m.frame.kind);
-    d.add(m.frame.camera.data(), m.frame.camera.size());
-    for (const Person3D& p : m.people) {
-      d.add(p.id);
-      d.add(p.positions);
-      d.add(p.rotations);
-      d.add(p.root);
-      d.add(p.provenance.clip.data(), p.provenance.clip.size());
-    }
-  } else if (packet.type == VideoFrame::kTypeName) {
-    const auto& m = static_cast<const VideoFrame&>(*packet.message);
-    const ImageBuffer& image = m.image;
-    d.add(m.camera.data(), m.camera.size());
-    d.add(image.format());
-    const auto row_bytes =
-        static_cast<std::size_t>(image.width() * bytes_per_pixel(image.format()));
-    for (int row = 0; row < image.height(); ++row) {
-      d.add(image.data() + static_cast<std::size_t>(row) * image.stride(), row_bytes);
-    }
-  }
-  return d.value();
-}
-
-}  // namespace
 
 class TestCollect : public Node {
  public:
@@ -92,7 +36,7 @@ class TestCollect : public Node {
     int n = std::snprintf(line, sizeof line, "%s %llu %lld %.*s %016llx", h.stream.c_str(),
                           static_cast<unsigned long long>(h.seq), static_cast<long long>(h.frame),
                           static_cast<int>(packet.type.size()), packet.type.data(),
-                          static_cast<unsigned long long>(digest(packet)));
+                          static_cast<unsigned long long>(content_digest(packet)));
     if (timing_) {
       std::snprintf(line + n, sizeof line - static_cast<std::size_t>(n), " %lld %.1f",
                     static_cast<long long>(h.capture_ns),

@@ -8,6 +8,7 @@
 #include <memory>
 #include <optional>
 
+#include "camera/rig_file.hpp"
 #include "graph/registry.hpp"
 #include "nodes/recon/node_camera.hpp"
 #include "web/frame_json.hpp"
@@ -31,11 +32,16 @@ class WebSink : public Node {
     c.param<std::string>("three_dir", "",
                          "the npm package three (default: the npm cache of tools/setup.sh)");
     declare_camera_params(c);
+    c.param<std::string>("rig", "",
+                         "rig file (.toml, .yml) of world-frame people (multi-view): its cameras "
+                         "are drawn where they stand");
   }
 
   void open(Context& ctx) override {
     if (NodeCamera camera = read_camera_params(ctx); camera.known())
       camera_ = web::ShownCamera{std::move(camera.camera), camera.assumed};
+    if (const std::string rig = ctx.param<std::string>("rig"); !rig.empty())
+      rig_ = camera::read_rig(rig);  // throws naming the file
     web::ServerOptions options;
     options.host = ctx.param<std::string>("host");
     options.port = ctx.param<int>("port");
@@ -52,7 +58,9 @@ class WebSink : public Node {
   }
 
   void process(Context& ctx) override {
-    server_->broadcast(web::frame_json(ctx.input<People3D>("in"), camera_));
+    const auto& people = ctx.input<People3D>("in");
+    server_->broadcast(people.frame.is_world() ? web::frame_json(people, rig_)
+                                               : web::frame_json(people, camera_));
     const auto now = std::chrono::steady_clock::now();
     if (now - last_status_ > std::chrono::seconds(1)) {
       last_status_ = now;
@@ -66,6 +74,7 @@ class WebSink : public Node {
 
  private:
   std::optional<web::ShownCamera> camera_;
+  camera::Rig rig_;  // for world-frame people; none: no camera drawn
   std::unique_ptr<web::WebServer> server_;
   std::chrono::steady_clock::time_point last_status_{};
 };

@@ -1,16 +1,14 @@
 // source.aravis: frames from a GigE Vision / USB3 Vision camera through Aravis (drivers/aravis).
 // A camera that stops answering (no data for loss_timeout_ms, or Aravis' heartbeat failed) is
 // reported, on stderr and as the node's status line in the graph's statistics, and reopened with
-// the same settings whenever it comes back; the graph keeps running meanwhile.
+// the same settings whenever it comes back (aravis::ReconnectingCamera); the graph keeps running.
 
 #include <cmath>
 #include <iostream>
 #include <memory>
-#include <thread>
-#include <vector>
 
-#include "camera.hpp"
 #include "graph/registry.hpp"
+#include "reconnecting_camera.hpp"
 
 namespace mocap::nodes {
 using namespace mocap::graph;
@@ -41,28 +39,31 @@ class AravisSource : public Node {
   }
 
   void open(Context& ctx) override {
-    settings_ = settings_from(ctx);
     count_ = ctx.param<std::uint64_t>("count");
     camera_name_ = ctx.param<std::string>("camera");
-    camera_ = std::make_unique<aravis::Camera>(settings_);  // throws naming the camera
-    report_open(ctx, "streaming from");
-    ctx.report_status("streaming from '" + camera_->info().id + "'");
+    camera_ = std::make_unique<aravis::ReconnectingCamera>(settings_from(ctx));  // throws naming it
+    std::cerr << ctx.node_name() << ": streaming from " << camera_->description() << "\n";
+    ctx.report_status(camera_->status());
   }
 
   void process(Context& ctx) override {
     if (count_ != 0 && seq_ >= count_) return ctx.finish();
-    if (!camera_ && !reconnect(ctx)) return;
     // Bounded, so that a stop request is seen within a fifth of a second.
-    auto frame = camera_->next(std::chrono::milliseconds(200));
-    account_drops(ctx);
-    if (camera_->control_lost()) return lose(ctx);
-    if (frame) send(ctx, std::move(*frame));
+    aravis::Poll poll = camera_->poll(std::chrono::milliseconds(200));
+    // Incomplete and never-seen frames count as this node's drops (shown with the graph's stats).
+    for (std::uint64_t i = 0; i < poll.new_drops; ++i) ctx.count_drop();
+    if (!poll.news.empty()) {
+      std::cerr << ctx.node_name() << ": " << poll.news << "\n";
+      ctx.report_status(camera_->status());
+    }
+    if (poll.away) ctx.sleep_for(std::chrono::milliseconds(500));  // wakes early on a stop
+    if (poll.frame) send(ctx, std::move(*poll.frame));
   }
 
   void close(Context& ctx) override {
-    if (camera_) account_drops(ctx);
-    std::cerr << ctx.node_name() << ": " << seq_ << " frames, " << incomplete_ << " incomplete, "
-              << skipped_ << " lost, " << reconnects_ << " reconnects\n";
+    const aravis::CaptureTotals& t = camera_->totals();
+    std::cerr << ctx.node_name() << ": " << seq_ << " frames, " << t.incomplete << " incomplete, "
+              << t.skipped << " lost, " << t.reconnects << " reconnects\n";
   }
 
  private:
@@ -82,13 +83,6 @@ class AravisSource : public Node {
     return s;
   }
 
-  void report_open(Context& ctx, const char* what) const {
-    const aravis::Region r = camera_->region();
-    std::cerr << ctx.node_name() << ": " << what << " camera '" << camera_->info().id << "' ("
-              << r.width << "x" << r.height << " " << camera_->pixel_format() << ", "
-              << camera_->frame_rate() << " fps, " << camera_->buffer_count() << " buffers)\n";
-  }
-
   void send(Context& ctx, aravis::Frame frame) {
     VideoFrame message;
     // `frame` counts delivered frames: unlike the camera's 16-bit block id it never wraps and
@@ -100,53 +94,9 @@ class AravisSource : public Node {
     ++seq_;
   }
 
-  // Incomplete and never-seen frames count as this node's drops (shown with the graph's stats).
-  void account_drops(Context& ctx) {
-    const aravis::StreamCounters now = camera_->counters();
-    for (auto n = now.incomplete + now.skipped_ids; n > seen_drops_; ++seen_drops_)
-      ctx.count_drop();
-    incomplete_ = base_incomplete_ + now.incomplete;
-    skipped_ = base_skipped_ + now.skipped_ids;
-  }
-
-  void lose(Context& ctx) {
-    const std::string what =
-        "camera '" + camera_->info().id + "' lost (" + camera_->loss_reason() + "); reconnecting";
-    std::cerr << ctx.node_name() << ": " << what << "\n";
-    ++losses_;
-    ctx.report_status(what + " [" + std::to_string(losses_) + " lost, " +
-                      std::to_string(reconnects_) + " reconnects]");
-    base_incomplete_ = incomplete_;
-    base_skipped_ = skipped_;
-    seen_drops_ = 0;
-    // Closing a camera that no longer answers waits for Aravis' timeouts (5 to 10 s on GigE):
-    // that happens on its own thread, so the reconnection attempts start at once.
-    closing_.emplace_back([camera = std::move(camera_)]() mutable { camera.reset(); });
-  }
-
-  // One attempt per call; between attempts the node sleeps (waking early when the graph stops).
-  bool reconnect(Context& ctx) {
-    try {
-      camera_ = std::make_unique<aravis::Camera>(settings_);
-    } catch (const std::runtime_error&) {
-      ctx.sleep_for(std::chrono::milliseconds(500));
-      return false;
-    }
-    ++reconnects_;
-    report_open(ctx, "reconnected to");
-    ctx.report_status("reconnected to camera '" + camera_->info().id + "' [" +
-                      std::to_string(losses_) + " lost, " + std::to_string(reconnects_) +
-                      " reconnects]");
-    return true;
-  }
-
-  aravis::CameraSettings settings_;
-  std::unique_ptr<aravis::Camera> camera_;
-  std::vector<std::jthread> closing_;  // lost cameras being closed; joined when the node goes
+  std::unique_ptr<aravis::ReconnectingCamera> camera_;
   std::uint64_t count_ = 0, seq_ = 0;
   std::string camera_name_;
-  std::uint64_t seen_drops_ = 0, incomplete_ = 0, skipped_ = 0, base_incomplete_ = 0,
-                base_skipped_ = 0, reconnects_ = 0, losses_ = 0;
 };
 
 MOCAP_REGISTER_NODE("source.aravis", AravisSource)

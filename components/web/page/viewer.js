@@ -42,11 +42,32 @@ const controls = new OrbitControls(view, canvas3d);
 controls.enableDamping = true;
 
 const toWorld = (p) => world.localToWorld(p.clone());
+// A camera's frame is turned half a turn about x (y down -> y up); a rig's world (frame.world) is
+// turned so that its up (frame.up: the floor's normal) is three.js's +y.
+let worldMode = false, upLocal = new THREE.Vector3(0, -1, 0);
+function orientWorld(frame) {
+  const up = frame.world && frame.up ? new THREE.Vector3(...frame.up).normalize()
+                                     : new THREE.Vector3(0, -1, 0);
+  if (worldMode === Boolean(frame.world) && up.equals(upLocal)) return;
+  worldMode = Boolean(frame.world);
+  upLocal = up;
+  if (worldMode) world.quaternion.setFromUnitVectors(up, new THREE.Vector3(0, 1, 0));
+  else world.rotation.set(Math.PI, 0, 0);
+  world.updateMatrixWorld(true);
+  viewSet = false;
+}
 function resetView(centre) {
-  // Between the camera (the origin) and the people, seen from above, behind and to the right.
-  const target = centre.clone().multiplyScalar(0.6);
-  controls.target.copy(toWorld(target));
-  view.position.copy(toWorld(target.clone().add(new THREE.Vector3(3.5, -2.5, -4.0))));
+  if (worldMode) {
+    // A rig's world: the people seen from above and to one side, the cameras around them.
+    const target = toWorld(centre);
+    controls.target.copy(target);
+    view.position.copy(target.clone().add(new THREE.Vector3(4.5, 4.0, 6.0)));
+  } else {
+    // Between the camera (the origin) and the people, seen from above, behind and to the right.
+    const target = centre.clone().multiplyScalar(0.6);
+    controls.target.copy(toWorld(target));
+    view.position.copy(toWorld(target.clone().add(new THREE.Vector3(3.5, -2.5, -4.0))));
+  }
   controls.update();
 }
 let lastCentre = new THREE.Vector3(0, 0.5, 3);
@@ -72,27 +93,64 @@ const cameraGroup = new THREE.Group();
 world.add(cameraGroup);
 cameraGroup.add(new THREE.Mesh(new THREE.BoxGeometry(0.12, 0.08, 0.06),
                                new THREE.MeshBasicMaterial({ color: 0xdfe6ee })));
-let frustum = null, frustumKey = "";
-function drawFrustum(camera) {
-  const key = JSON.stringify(camera);
-  if (key === frustumKey) return;
-  frustumKey = key;
-  if (frustum) { cameraGroup.remove(frustum); frustum.geometry.dispose(); frustum.material.dispose(); }
-  const c = camera.known ? camera : { width: 640, height: 480, fx: 554, fy: 554, cx: 320, cy: 240 };
-  const D = 0.8;
+// Lines of a frustum to depth D in the camera's frame (x right, y down, z forward), with a roof
+// on the top edge: which way is up.
+function frustumLines(c, D, colour) {
   const corner = (u, v) => [((u - c.cx) / c.fx) * D, ((v - c.cy) / c.fy) * D, D];
   const k = [corner(0, 0), corner(c.width, 0), corner(c.width, c.height), corner(0, c.height)];
   const up = [((c.width / 2 - c.cx) / c.fx) * D, ((-0.15 * c.height - c.cy) / c.fy) * D, D];
   const p = [];
   for (let i = 0; i < 4; ++i) p.push(0, 0, 0, ...k[i], ...k[i], ...k[(i + 1) % 4]);
-  p.push(...k[0], ...up, ...up, ...k[1]);  // a roof on the top edge: which way is up
+  p.push(...k[0], ...up, ...up, ...k[1]);
   const geometry = new THREE.BufferGeometry();
   geometry.setAttribute("position", new THREE.Float32BufferAttribute(p, 3));
-  frustum = new THREE.LineSegments(geometry, new THREE.LineBasicMaterial({
-    color: camera.known ? (camera.assumed ? 0xc9b458 : 0x7fd0ff) : 0x777777 }));
+  return new THREE.LineSegments(geometry, new THREE.LineBasicMaterial({ color: colour }));
+}
+function disposeTree(object) {
+  object.traverse((o) => { if (o.geometry) o.geometry.dispose(); if (o.material) o.material.dispose(); });
+}
+
+let frustum = null, frustumKey = "";
+function drawFrustum(camera) {
+  const key = JSON.stringify(camera);
+  if (key === frustumKey) return;
+  frustumKey = key;
+  if (frustum) { cameraGroup.remove(frustum); disposeTree(frustum); }
+  const c = camera.known ? camera : { width: 640, height: 480, fx: 554, fy: 554, cx: 320, cy: 240 };
+  frustum = frustumLines(c, 0.8, camera.known ? (camera.assumed ? 0xc9b458 : 0x7fd0ff) : 0x777777);
   cameraGroup.add(frustum);
   cameraLabel.textContent = camera.known
     ? (camera.assumed ? "camera (field of view assumed)" : "camera") : "camera (intrinsics unknown)";
+}
+
+// A rig's cameras (world-frame messages): each where it stands, its frustum to 1 m, its name.
+const rigGroup = new THREE.Group();
+world.add(rigGroup);
+let rigKey = "", rigLabels = [];
+function drawRig(cameras) {
+  const key = JSON.stringify(cameras);
+  if (key === rigKey) return;
+  rigKey = key;
+  for (const child of [...rigGroup.children]) { rigGroup.remove(child); disposeTree(child); }
+  for (const l of rigLabels) l.element.remove();
+  rigLabels = [];
+  for (const c of cameras) {
+    const g = new THREE.Group();
+    const r = c.rotation;  // camera -> world, row-major
+    g.matrixAutoUpdate = false;
+    g.matrix.set(r[0], r[1], r[2], c.position[0], r[3], r[4], r[5], c.position[1],
+                 r[6], r[7], r[8], c.position[2], 0, 0, 0, 1);
+    g.add(new THREE.Mesh(new THREE.BoxGeometry(0.12, 0.08, 0.06),
+                         new THREE.MeshBasicMaterial({ color: 0xdfe6ee })));
+    g.add(frustumLines(c, 1.0, 0x7fd0ff));
+    rigGroup.add(g);
+    const element = document.createElement("div");
+    element.className = "label";
+    element.style.background = "#7fd0ff";
+    element.textContent = c.name;
+    labels.appendChild(element);
+    rigLabels.push({ element, at: new THREE.Vector3(...c.position) });
+  }
 }
 
 // People: bones as cylinders and joints as spheres (one instanced mesh each), unlit so that
@@ -163,7 +221,7 @@ function drawPerson(p, person) {
     p.joints.setMatrixAt(i, jointAt(j, i, a) ? matrix.makeTranslation(a.x, a.y, a.z) : HIDDEN);
   }
   p.bones.instanceMatrix.needsUpdate = p.joints.instanceMatrix.needsUpdate = true;
-  if (jointAt(j, headIndex(), a)) p.head.set(a.x, a.y - 0.22, a.z);
+  if (jointAt(j, headIndex(), a)) p.head.copy(a).addScaledVector(upLocal, 0.22);
 }
 
 function placeLabel(label, local) {
@@ -241,6 +299,7 @@ window.viewerStats = stats;
 let pending = null;
 
 function applyFrame(frame) {
+  orientWorld(frame);
   const seen = new Set();
   const centre = new THREE.Vector3();
   let counted = 0;
@@ -256,8 +315,12 @@ function applyFrame(frame) {
     if (!viewSet) { resetView(lastCentre); viewSet = true; }
   }
   placeGrid(frame.ground, lastCentre);
-  drawFrustum(frame.camera);
+  cameraGroup.visible = !frame.world;
+  if (frame.world) drawRig(frame.cameras || []);
+  else drawFrustum(frame.camera);
+  rigGroup.visible = Boolean(frame.world);
   draw2d(frame);
+  stats.cameras = frame.world ? rigGroup.children.length : 1;
   stats.people = frame.people.length;
   stats.frame = frame.frame;
   $("people").textContent = String(frame.people.length);
@@ -326,7 +389,12 @@ function tick(now) {
   renderer.render(scene, view);
   ++stats.rendered;
   for (const p of people.values()) placeLabel(p.label, p.head);
-  placeLabel(cameraLabel, new THREE.Vector3(0, -0.12, 0));
+  if (worldMode) cameraLabel.style.display = "none";
+  else placeLabel(cameraLabel, new THREE.Vector3(0, -0.12, 0));
+  for (const l of rigLabels) {
+    if (worldMode) placeLabel(l.element, l.at);
+    else l.element.style.display = "none";
+  }
   if (now - windowStart >= 1000) {
     const seconds = (now - windowStart) / 1000;
     const fps = (stats.drawn - drawnAtStart) / seconds;
