@@ -191,6 +191,7 @@ int main(int argc, char** argv) {
       .flag("quick", "only the 4-camera run with given intrinsics");
   int code = 0;
   if (!args.parse(argc - 1, argv + 1, code)) return code;
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);  // tables as they come, also into a file
   const int frames = static_cast<int>(args.integer("frames"));
   const int width = static_cast<int>(args.integer("width"));
   const int height = static_cast<int>(args.integer("height"));

@@ -499,7 +499,8 @@ int rig_board_command(int argc, char** argv) {
               "take each camera's matrix, distortion and size from this rig file (by name); its "
               "poses are ignored")
       .flag("refine-intrinsics",
-            "also refine fx, fy, cx, cy and k1 k2 p1 p2 in the bundle (k3 stays)")
+            "also refine fx, fy, cx, cy and k1 k2 p1 p2 in the bundle (k3 stays); advised without "
+            "--intrinsics (docs/cameras.md)")
       .option("floor-frame", "N",
               "the frame in which the board lies flat on the floor (default: the first frame in "
               "which a camera sees the board)",
