@@ -182,14 +182,18 @@ TEST_F(RigCalibration, ViewsOfDifferentLengthsAreRefusedWithTheirCounts) {
   }
 }
 
-TEST_F(RigCalibration, UnreadableViewsAreNamed) {
-  const std::string missing = (dir_->path() / "no-such-view").string();
-  const std::string not_video = (dir_->path() / "garbage.mp4").string();
+// Without the rendered room: the bad view is read first and refused before the other.
+TEST(RigCalibrationViews, UnreadableViewsAreNamed) {
+  test::TempDir dir;
+  RigBoardOptions options;
+  options.board = test::VirtualRoom{}.board;
+  const std::string missing = dir.file("no-such-view");
+  const std::string not_video = dir.file("garbage.mp4");
   test::write_file(not_video, "this is not a video");
-  const fs::path folder_with_garbage = dir_->path() / "garbage-images";
+  const fs::path folder_with_garbage = dir.path() / "garbage-images";
   fs::create_directories(folder_with_garbage);
   test::write_file((folder_with_garbage / "frame_000.png").string(), "not a png");
-  const fs::path no_images = dir_->path() / "no-images";
+  const fs::path no_images = dir.path() / "no-images";
   fs::create_directories(no_images);
   for (const std::string& bad :
        {missing, not_video, (folder_with_garbage / "frame_000.png").string(), no_images.string()}) {
@@ -197,9 +201,9 @@ TEST_F(RigCalibration, UnreadableViewsAreNamed) {
     const std::vector<std::string> folders{bad == (folder_with_garbage / "frame_000.png").string()
                                                ? folder_with_garbage.string()
                                                : bad,
-                                           folders_[0]};
+                                           dir.file("never-read")};
     try {
-      find_rig_board(folders, {"cam_03", "cam_01"}, options_);
+      find_rig_board(folders, {"cam_03", "cam_01"}, options);
       ADD_FAILURE() << bad << " was accepted";
     } catch (const InputError& e) {
       const std::string what = e.what();
