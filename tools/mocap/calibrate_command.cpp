@@ -6,6 +6,8 @@
 // camera file.
 // `mocap calibrate ground`: the floor from one image of a board lying on it
 // (camera/ground_from_board.hpp), added to the camera file.
+// `mocap calibrate rig`: several cameras posed in one world from a board they all film
+// (camera/rig_calibration.hpp), written as a rig file.
 
 #include <algorithm>
 #include <cctype>
@@ -25,12 +27,14 @@
 #include "camera/chessboard_calibration.hpp"
 #include "camera/ground_from_board.hpp"
 #include "camera/rig.hpp"
+#include "camera/rig_calibration.hpp"
 #include "camera/rig_file.hpp"
 #include "cli_args.hpp"
 #include "commands.hpp"
 #include "core/input_error.hpp"
 #include "eval/layout_calibration.hpp"
 #include "eval_report.hpp"
+#include "progress_bar.hpp"
 
 namespace mocap::cli {
 namespace {
@@ -466,6 +470,123 @@ int ground_command(int argc, char** argv) {
   return 0;
 }
 
+// > 1: a factor of the median error.
+Range outlier_range() {
+  Range r = Range::between(1.0, 1000.0);
+  r.above_min = true;
+  return r;
+}
+
+int rig_board_command(int argc, char** argv) {
+  Args args(
+      "mocap calibrate rig VIEW1 VIEW2 ... [--board charuco ...] --square MM --out RIG.toml",
+      "Calibrates several cameras together from a chessboard or ChArUco board that they all "
+      "film: one\nview per camera (a video, or a folder of images in name order), in step "
+      "(frame i of every view\ntaken at the same instant). Finds the board in every --step-th "
+      "frame, calibrates each camera's\nintrinsics from its own frames (or takes them from "
+      "--intrinsics), chains the cameras' poses over\nthe frames they share, refines all "
+      "camera and board poses in one bundle adjustment (dropping\ncorners off by more than "
+      "--outlier x the median and solving again), and sets the world from\nthe board lying "
+      "on the floor in --floor-frame: origin at the board's origin, x along the board,\nz up, "
+      "metres from --square. Prints each camera's RMS reprojection error and writes the rig\n"
+      "(.toml: Pose2Sim/anipose layout; .yml: OpenCV YAML; docs/cameras.md).");
+  args.positional("views", "a video or a folder of images per camera, in the rig's order", true);
+  board_options(args);
+  args.option("cameras", "NAMES",
+              "comma-separated camera names, one per view (default: those of --intrinsics, "
+              "else cam_01, cam_02, ...)")
+      .option("intrinsics", "RIG",
+              "take each camera's matrix, distortion and size from this rig file (by name); its "
+              "poses are ignored")
+      .flag("refine-intrinsics",
+            "also refine fx, fy, cx, cy and k1 k2 p1 p2 in the bundle (k3 stays); advised without "
+            "--intrinsics (docs/cameras.md)")
+      .option("floor-frame", "N",
+              "the frame in which the board lies flat on the floor (default: the first frame in "
+              "which a camera sees the board)",
+              std::nullopt, Range::count(0))
+      .option("thickness", "MM", "thickness of the board: the floor lies this far below it", "0",
+              Range::at_least(0))
+      .option("step", "N", "search every Nth frame of each view", "1", Range::count(1))
+      .option("outlier", "X", "drop corners whose error exceeds X times the median (> 1)", "3",
+              outlier_range())
+      .flag("drop-unconnected",
+            "leave out cameras that never see the board (or never together with the others) "
+            "instead of refusing")
+      .option("out", "FILE", "where to write the rig (.toml or .yml; nothing written when absent)");
+  int code = 0;
+  if (!args.parse(argc, argv, code)) return code;
+  const std::vector<std::string>& views = args.positionals();
+  if (views.size() < 2) throw InputError("mocap calibrate rig", "give at least 2 views");
+  camera::RigBoardOptions options;
+  options.board = board_from(args);
+  options.step = static_cast<int>(args.integer("step"));
+  options.refine_intrinsics = args.has("refine-intrinsics");
+  options.outlier_factor = args.number("outlier");
+  options.board_thickness_mm = args.number("thickness");
+  options.drop_unconnected = args.has("drop-unconnected");
+  if (args.has("floor-frame")) options.floor_frame = static_cast<int>(args.integer("floor-frame"));
+  if (args.has("out")) camera::rig_format_for_writing(args.get("out"));  // a bad name fails now
+
+  std::vector<std::string> names;
+  if (args.has("intrinsics")) {
+    options.intrinsics_source = args.get("intrinsics");
+    options.intrinsics = camera::read_rig(options.intrinsics_source);
+  }
+  if (args.has("cameras")) {
+    std::stringstream list(args.get("cameras"));
+    for (std::string name; std::getline(list, name, ',');) names.push_back(name);
+    if (names.size() != views.size())
+      throw InputError("--cameras", std::to_string(names.size()) + " names for " +
+                                        std::to_string(views.size()) + " views");
+  } else if (options.intrinsics) {
+    const auto& cameras = options.intrinsics->cameras;
+    for (std::size_t i = 0; i < views.size(); ++i) {
+      if (i >= cameras.size())
+        throw InputError(options.intrinsics_source,
+                         "has " + std::to_string(cameras.size()) + " cameras, no camera for view " +
+                             std::to_string(i + 1) + " (" + views[i] +
+                             "): add it, or name the views' cameras with --cameras");
+      names.push_back(cameras[i].name);
+    }
+  } else {
+    for (std::size_t i = 0; i < views.size(); ++i)
+      names.push_back(std::string("cam_") + (i < 9 ? "0" : "") + std::to_string(i + 1));
+  }
+
+  ProgressBar bar;
+  options.progress = [&bar](const std::string& stage, double fraction) {
+    bar.update(stage, fraction);
+  };
+  const camera::RigCalibration result = camera::calibrate_rig_from_board(views, names, options);
+  bar.finish();
+
+  std::cout << "board " << camera::describe(options.board) << "\n"
+            << result.frames_used << " frames with the board; the floor from frame "
+            << result.floor_frame << "\n";
+  for (const std::string& note : result.notes) std::cout << "note: " << note << "\n";
+  std::cout << "\n| camera | frames with board | corners used | dropped | RMS px | fx | fy | cx | "
+               "cy | position m |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---|\n";
+  for (std::size_t k = 0; k < result.rig.cameras.size(); ++k) {
+    const camera::Camera& c = result.rig.cameras[k];
+    const auto& r = result.cameras[k];
+    const glm::dvec3 p = c.centre();
+    std::cout << "| " << c.name << " | " << r.frames_with_board << " | " << r.observations << " | "
+              << r.dropped << " | " << fixed(r.rms_px, 3) << " | " << fixed(c.fx, 1) << " | "
+              << fixed(c.fy, 1) << " | " << fixed(c.cx, 1) << " | " << fixed(c.cy, 1) << " | "
+              << fixed(p.x, 3) << " " << fixed(p.y, 3) << " " << fixed(p.z, 3) << " |\n";
+  }
+  std::cout << "\nRMS reprojection error " << fixed(result.rms_px, 3) << " px\n";
+  if (args.has("out")) {
+    const fs::path out = args.get("out");
+    if (out.has_parent_path()) fs::create_directories(out.parent_path());
+    camera::write_rig(out, result.rig);
+    camera::read_rig(out);  // what was written reads back
+    std::cout << "wrote " << out.string() << "\n";
+  }
+  return 0;
+}
+
 }  // namespace
 
 int calibrate_command(int argc, char** argv) {
@@ -477,6 +598,8 @@ int calibrate_command(int argc, char** argv) {
        intrinsics_command},
       {"ground", "the floor from an image of a board lying on it (added to the camera file)",
        ground_command},
+      {"rig", "several cameras in one world from a board they all film (a rig file)",
+       rig_board_command},
   };
   return run_subcommand("calibrate", kSubcommands, argc, argv);
 }

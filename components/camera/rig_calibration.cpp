@@ -1,0 +1,579 @@
+#include "camera/rig_calibration.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <numeric>
+#include <sstream>
+#include <stdexcept>
+#include <utility>
+
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/videoio.hpp>
+
+#include "camera/board_detection.hpp"
+#include "core/input_error.hpp"
+
+namespace mocap::camera {
+namespace {
+
+namespace fs = std::filesystem;
+using namespace rig_calibration_detail;
+
+// ---------------------------------------------------------------- finding the board in the views
+
+bool is_image_file(const fs::path& p) {
+  std::string ext = p.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  for (const char* known :
+       {".jpg", ".jpeg", ".png", ".bmp", ".tif", ".tiff", ".ppm", ".pgm", ".pbm", ".webp"})
+    if (ext == known) return true;
+  return false;
+}
+
+std::vector<std::string> images_in(const std::string& folder, const std::string& camera) {
+  std::vector<std::string> files;
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(folder, ec))
+    if (entry.is_regular_file() && is_image_file(entry.path()))
+      files.push_back(entry.path().string());
+  if (ec)
+    throw InputError(folder,
+                     "cannot read the folder (camera " + camera + ": " + ec.message() + ")");
+  if (files.empty())
+    throw InputError(folder, "no image files in this folder (camera " + camera + ")");
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+class BoardFinder {
+ public:
+  BoardFinder(CameraBoardViews& view, const RigBoardOptions& options)
+      : view_(view), options_(options) {}
+
+  // Frame `index` of the view, named `where` in messages.
+  void add(const std::string& where, const cv::Mat& image) {
+    if (image.empty()) throw InputError(where, "unreadable image (camera " + view_.name + ")");
+    if (view_.frames == 0) {
+      view_.width = image.cols;
+      view_.height = image.rows;
+    } else if (image.cols != view_.width || image.rows != view_.height) {
+      throw InputError(where, "the image is " + std::to_string(image.cols) + "x" +
+                                  std::to_string(image.rows) + ", the view's first frame is " +
+                                  std::to_string(view_.width) + "x" + std::to_string(view_.height));
+    }
+    const int index = view_.frames++;
+    view_.boards.emplace_back();
+    if (index % options_.step != 0) return;
+    ++view_.tried;
+    const detail::BoardDetection found =
+        detail::detect_board(detail::to_gray(image), options_.board, options_.min_corners);
+    if (!found.found()) return;
+    BoardObservation seen;
+    for (std::size_t i = 0; i < found.corners.image.size(); ++i) {
+      const cv::Point3f& o = found.corners.object[i];
+      const cv::Point2f& p = found.corners.image[i];
+      seen.object_mm.push_back({o.x, o.y, o.z});
+      seen.pixels.push_back({p.x, p.y});
+    }
+    view_.boards.back() = std::move(seen);
+  }
+
+ private:
+  CameraBoardViews& view_;
+  const RigBoardOptions& options_;
+};
+
+void report(const RigBoardOptions& options, const std::string& stage, double fraction) {
+  if (options.progress) options.progress(stage, std::clamp(fraction, 0.0, 1.0));
+}
+
+CameraBoardViews find_in_view(const std::string& source, const std::string& name,
+                              const RigBoardOptions& options) {
+  CameraBoardViews view;
+  view.name = name;
+  view.source = source;
+  BoardFinder finder(view, options);
+  const std::string stage = name + ": finding the board";
+  std::error_code ec;
+  if (fs::is_directory(source, ec)) {
+    const std::vector<std::string> files = images_in(source, name);
+    for (std::size_t i = 0; i < files.size(); ++i) {
+      cv::Mat image;
+      try {
+        image = cv::imread(files[i], cv::IMREAD_COLOR);
+      } catch (const cv::Exception&) {
+        image = cv::Mat();
+      }
+      finder.add(files[i], image);
+      report(options, stage, static_cast<double>(i + 1) / static_cast<double>(files.size()));
+    }
+    return view;
+  }
+  if (!fs::exists(source, ec))
+    throw InputError(source, "no such file or folder (camera " + name + ")");
+  cv::VideoCapture capture;
+  try {
+    capture.open(source, cv::CAP_FFMPEG);  // a file: FFmpeg (see board.cpp)
+  } catch (const cv::Exception&) {
+  }
+  if (!capture.isOpened())
+    throw InputError(source, "cannot open the video (camera " + name +
+                                 "; a view is a video file or a folder of images)");
+  const double expected = std::max(1.0, capture.get(cv::CAP_PROP_FRAME_COUNT));
+  cv::Mat frame;
+  while (capture.read(frame)) {
+    finder.add(source + "#" + std::to_string(view.frames), frame);
+    report(options, stage, view.frames / expected);
+  }
+  if (view.frames == 0) throw InputError(source, "no frame could be decoded (camera " + name + ")");
+  return view;
+}
+
+// ---------------------------------------------------------------- poses
+
+cv::Matx33d matrix_of(const Camera& c) { return {c.fx, 0, c.cx, 0, c.fy, c.cy, 0, 0, 1}; }
+
+cv::Mat distortion_of(const Camera& c) {
+  if (c.distortion.empty()) return cv::Mat::zeros(1, 5, CV_64F);
+  return cv::Mat(c.distortion, true).reshape(1, 1);
+}
+
+struct Rigid {
+  cv::Matx33d R = cv::Matx33d::eye();
+  cv::Vec3d t;
+  Rigid operator*(const Rigid& o) const { return {R * o.R, R * o.t + t}; }
+  Rigid inverse() const { return {R.t(), -(R.t() * t)}; }
+};
+
+Rigid rigid(const Pose& p) {
+  Rigid r;
+  cv::Rodrigues(cv::Vec3d(p.rotation[0], p.rotation[1], p.rotation[2]), r.R);
+  r.t = {p.translation[0], p.translation[1], p.translation[2]};
+  return r;
+}
+
+Pose pose_of(const Rigid& r) {
+  cv::Vec3d v;
+  cv::Rodrigues(r.R, v);
+  return {{v[0], v[1], v[2]}, {r.t[0], r.t[1], r.t[2]}};
+}
+
+std::vector<cv::Point3f> object_points_m(const BoardObservation& b) {
+  std::vector<cv::Point3f> out;
+  for (const auto& o : b.object_mm)
+    out.emplace_back(static_cast<float>(o[0] / 1000), static_cast<float>(o[1] / 1000),
+                     static_cast<float>(o[2] / 1000));
+  return out;
+}
+
+std::vector<cv::Point2f> image_points(const BoardObservation& b) {
+  std::vector<cv::Point2f> out;
+  for (const auto& p : b.pixels)
+    out.emplace_back(static_cast<float>(p[0]), static_cast<float>(p[1]));
+  return out;
+}
+
+// The board -> camera pose of one observation (IPPE for a planar target, then LM).
+Rigid board_pose(const BoardObservation& b, const Camera& c) {
+  const auto object = object_points_m(b);
+  const auto pixels = image_points(b);
+  cv::Mat rvec, tvec;
+  const cv::Mat K(matrix_of(c));
+  const cv::Mat D = distortion_of(c);
+  cv::solvePnP(object, pixels, K, D, rvec, tvec, false, cv::SOLVEPNP_IPPE);
+  cv::solvePnPRefineLM(object, pixels, K, D, rvec, tvec);
+  Rigid r;
+  cv::Rodrigues(rvec, r.R);
+  r.t = {tvec.at<double>(0), tvec.at<double>(1), tvec.at<double>(2)};
+  return r;
+}
+
+// The rotation nearest (Frobenius) to the mean of rotations; the per-axis median translation.
+Rigid robust_mean(const std::vector<Rigid>& samples) {
+  cv::Matx33d sum = cv::Matx33d::zeros();
+  for (const Rigid& s : samples) sum += s.R;
+  cv::Mat w, u, vt;
+  cv::SVD::compute(cv::Mat(sum), w, u, vt);
+  cv::Mat R = u * vt;
+  if (cv::determinant(R) < 0) {
+    u.col(2) *= -1;
+    R = u * vt;
+  }
+  Rigid out;
+  out.R = cv::Matx33d(R);
+  for (int axis = 0; axis < 3; ++axis) {
+    std::vector<double> values;
+    for (const Rigid& s : samples) values.push_back(s.t[axis]);
+    std::nth_element(values.begin(), values.begin() + static_cast<long>(values.size() / 2),
+                     values.end());
+    out.t[axis] = values[values.size() / 2];
+  }
+  return out;
+}
+
+// ---------------------------------------------------------------- intrinsics
+
+Camera intrinsics_from_views(const CameraBoardViews& view, const RigBoardOptions& options,
+                             double& rms) {
+  std::vector<std::size_t> frames;
+  for (std::size_t f = 0; f < view.boards.size(); ++f)
+    if (view.boards[f]) frames.push_back(f);
+  if (static_cast<int>(frames.size()) < options.min_intrinsic_views)
+    throw InputError(view.source,
+                     "camera " + view.name + ": the board was found in " +
+                         std::to_string(frames.size()) + " of " + std::to_string(view.tried) +
+                         " frames tried, at least " + std::to_string(options.min_intrinsic_views) +
+                         " are needed for its intrinsics (or give them with --intrinsics)");
+  // At most 40 views, spread over the recording: more adds time, not accuracy.
+  constexpr std::size_t kMaxViews = 40;
+  std::vector<std::vector<cv::Point3f>> object;
+  std::vector<std::vector<cv::Point2f>> pixels;
+  const std::size_t take = std::min(kMaxViews, frames.size());
+  for (std::size_t i = 0; i < take; ++i) {
+    const BoardObservation& b = *view.boards[frames[i * frames.size() / take]];
+    object.push_back(object_points_m(b));
+    pixels.push_back(image_points(b));
+  }
+  cv::Mat K, D, rvecs, tvecs;
+  // k3 held at zero, as OpenCV advises for ordinary lenses: a board far from the camera fills
+  // little of the image, and a free k3 trades against the focal length.
+  rms = cv::calibrateCamera(object, pixels, cv::Size(view.width, view.height), K, D, rvecs, tvecs,
+                            cv::CALIB_FIX_K3);
+  Camera c;
+  c.name = view.name;
+  c.width = view.width;
+  c.height = view.height;
+  c.fx = K.at<double>(0, 0);
+  c.fy = K.at<double>(1, 1);
+  c.cx = K.at<double>(0, 2);
+  c.cy = K.at<double>(1, 2);
+  c.distortion.assign(D.begin<double>(), D.end<double>());
+  return c;
+}
+
+Camera given_intrinsics(const CameraBoardViews& view, const RigBoardOptions& options) {
+  const Rig& rig = *options.intrinsics;
+  const Camera* found = rig.find(view.name);
+  if (!found) {
+    std::string names;
+    for (const Camera& c : rig.cameras) names += (names.empty() ? "" : ", ") + c.name;
+    throw InputError(options.intrinsics_source, "has no camera '" + view.name + "' (for " +
+                                                    view.source + "; it has " + names + ")");
+  }
+  if (found->width != view.width || found->height != view.height)
+    throw InputError(options.intrinsics_source,
+                     "camera " + view.name + " is " + std::to_string(found->width) + "x" +
+                         std::to_string(found->height) + ", its view " + view.source + " is " +
+                         std::to_string(view.width) + "x" + std::to_string(view.height));
+  Camera c = *found;
+  c.rotation = glm::dmat3(1.0);
+  c.translation = glm::dvec3(0.0);
+  return c;
+}
+
+// ---------------------------------------------------------------- the camera graph
+
+struct Graph {
+  std::size_t root = 0;
+  std::vector<std::optional<std::size_t>> parent;  // per camera; root and unreached: none
+  std::vector<bool> reached;
+  std::vector<std::size_t> order;  // root first, each camera after its parent
+};
+
+std::vector<std::vector<int>> shared_frames(const std::vector<const CameraBoardViews*>& views) {
+  const std::size_t n = views.size();
+  std::vector<std::vector<int>> shared(n, std::vector<int>(n, 0));
+  for (std::size_t a = 0; a < n; ++a)
+    for (std::size_t b = a + 1; b < n; ++b) {
+      const std::size_t frames = std::min(views[a]->boards.size(), views[b]->boards.size());
+      for (std::size_t f = 0; f < frames; ++f)
+        if (views[a]->boards[f] && views[b]->boards[f]) ++shared[a][b], ++shared[b][a];
+    }
+  return shared;
+}
+
+// Prim's algorithm on the most shared frames, from the camera that saw the board most often.
+Graph spanning_tree(const std::vector<std::vector<int>>& shared, const std::vector<int>& seen) {
+  const std::size_t n = shared.size();
+  Graph g;
+  g.parent.assign(n, std::nullopt);
+  g.reached.assign(n, false);
+  g.root = static_cast<std::size_t>(std::max_element(seen.begin(), seen.end()) - seen.begin());
+  g.reached[g.root] = true;
+  g.order.push_back(g.root);
+  for (;;) {
+    int best = 0;
+    std::size_t from = 0, to = 0;
+    for (std::size_t a : g.order)
+      for (std::size_t b = 0; b < n; ++b)
+        if (!g.reached[b] && shared[a][b] > best) best = shared[a][b], from = a, to = b;
+    if (best == 0) break;
+    g.parent[to] = from;
+    g.reached[to] = true;
+    g.order.push_back(to);
+  }
+  return g;
+}
+
+// ---------------------------------------------------------------- the world from the floor board
+
+// World <- board of the floor frame: x along the board's x, y against its y, z up (the board's z
+// points into the floor for a board lying face up).
+Rigid world_from_floor_board() { return {cv::Matx33d(1, 0, 0, 0, -1, 0, 0, 0, -1), {}}; }
+
+glm::dmat3 to_glm(const cv::Matx33d& m) {
+  glm::dmat3 out;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) out[c][r] = m(r, c);
+  return out;
+}
+
+double median(std::vector<double> values) {
+  if (values.empty()) return 0.0;
+  std::nth_element(values.begin(), values.begin() + static_cast<long>(values.size() / 2),
+                   values.end());
+  return values[values.size() / 2];
+}
+
+void check(const RigBoardOptions& o) {
+  check_board(o.board);
+  if (o.step < 1) throw std::invalid_argument("rig calibration: step must be at least 1");
+  if (o.min_corners < 4) throw std::invalid_argument("rig calibration: at least 4 corners");
+  if (o.min_intrinsic_views < 3)
+    throw std::invalid_argument("rig calibration: at least 3 views for intrinsics");
+  if (!(o.outlier_factor > 1)) throw std::invalid_argument("rig calibration: outlier factor > 1");
+  if (o.outlier_rounds < 0) throw std::invalid_argument("rig calibration: outlier rounds >= 0");
+  if (!(o.board_thickness_mm >= 0 && std::isfinite(o.board_thickness_mm)))
+    throw std::invalid_argument("rig calibration: thickness must be finite and >= 0");
+}
+
+}  // namespace
+
+std::vector<CameraBoardViews> find_rig_board(const std::vector<std::string>& views,
+                                             const std::vector<std::string>& names,
+                                             const RigBoardOptions& options) {
+  check(options);
+  if (views.size() != names.size())
+    throw std::invalid_argument("find_rig_board: one name per view");
+  std::vector<CameraBoardViews> out;
+  for (std::size_t i = 0; i < views.size(); ++i)
+    out.push_back(find_in_view(views[i], names[i], options));
+  const bool equal = std::all_of(out.begin(), out.end(), [&](const CameraBoardViews& v) {
+    return v.frames == out.front().frames;
+  });
+  if (!equal) {
+    std::string counts;
+    for (const auto& v : out)
+      counts +=
+          (counts.empty() ? "" : ", ") + v.name + " (" + v.source + ") " + std::to_string(v.frames);
+    throw InputError("views", "different frame counts: " + counts +
+                                  ". Frame i of every view must be taken at the same instant; "
+                                  "trim the views to the same frames");
+  }
+  return out;
+}
+
+RigCalibration calibrate_rig(const std::vector<CameraBoardViews>& all_views,
+                             const RigBoardOptions& options) {
+  check(options);
+  if (all_views.size() < 2)
+    throw InputError(
+        "views", "a rig needs at least 2 cameras, " + std::to_string(all_views.size()) + " given");
+  RigCalibration result;
+  const std::string board = describe(options.board);
+
+  // Cameras that never saw the board.
+  std::vector<const CameraBoardViews*> views;
+  for (const CameraBoardViews& v : all_views) {
+    const auto seen = std::count_if(v.boards.begin(), v.boards.end(),
+                                    [](const auto& b) { return b.has_value(); });
+    if (seen > 0) {
+      views.push_back(&v);
+      continue;
+    }
+    const std::string what = "camera " + v.name + ": the board (" + board +
+                             ") was not found in any of the " + std::to_string(v.tried) +
+                             " frames tried";
+    if (!options.drop_unconnected) throw InputError(v.source, what);
+    result.notes.push_back(what + "; left out of the rig");
+  }
+  if (views.size() < 2) throw InputError("views", "fewer than 2 cameras saw the board");
+
+  // Intrinsics.
+  std::vector<Camera> cameras;
+  std::vector<double> intrinsic_rms;
+  for (std::size_t i = 0; i < views.size(); ++i) {
+    report(options, "intrinsics", static_cast<double>(i) / static_cast<double>(views.size()));
+    double rms = 0.0;
+    cameras.push_back(options.intrinsics ? given_intrinsics(*views[i], options)
+                                         : intrinsics_from_views(*views[i], options, rms));
+    cameras.back().name = views[i]->name;
+    intrinsic_rms.push_back(rms);
+  }
+
+  // Board poses per camera, the camera graph, its unconnected cameras.
+  report(options, "camera graph", 0.0);
+  std::vector<int> seen;
+  for (const auto* v : views)
+    seen.push_back(static_cast<int>(std::count_if(v->boards.begin(), v->boards.end(),
+                                                  [](const auto& b) { return b.has_value(); })));
+  const auto shared = shared_frames(views);
+  const Graph graph = spanning_tree(shared, seen);
+  std::vector<std::size_t> kept;  // indices into views, in view order
+  std::string left_out;
+  for (std::size_t i = 0; i < views.size(); ++i) {
+    if (graph.reached[i]) {
+      kept.push_back(i);
+      continue;
+    }
+    left_out += (left_out.empty() ? "" : ", ") + views[i]->name + " (" + views[i]->source + ")";
+  }
+  if (!left_out.empty()) {
+    const std::string what = "camera(s) " + left_out +
+                             " never see the board in a frame that the other cameras (from " +
+                             views[graph.root]->name + ") see it in";
+    if (!options.drop_unconnected)
+      throw InputError("views", what +
+                                    ": film the board where they overlap, or leave them out "
+                                    "(--drop-unconnected)");
+    result.notes.push_back(what + "; left out of the rig");
+  }
+
+  const std::size_t frames = views.front()->boards.size();
+  std::vector<std::vector<std::optional<Rigid>>> board_in_camera(views.size());
+  for (std::size_t i : kept) {
+    board_in_camera[i].resize(frames);
+    for (std::size_t f = 0; f < std::min(frames, views[i]->boards.size()); ++f)
+      if (views[i]->boards[f]) board_in_camera[i][f] = board_pose(*views[i]->boards[f], cameras[i]);
+  }
+  // World = the root camera's frame until the floor board sets it.
+  std::vector<Rigid> camera_from_world(views.size());
+  for (std::size_t i : graph.order) {
+    if (!graph.parent[i]) continue;
+    const std::size_t p = *graph.parent[i];
+    std::vector<Rigid> samples;  // child <- parent, one per shared frame
+    for (std::size_t f = 0; f < frames; ++f)
+      if (board_in_camera[i][f] && board_in_camera[p][f])
+        samples.push_back(*board_in_camera[i][f] * board_in_camera[p][f]->inverse());
+    camera_from_world[i] = robust_mean(samples) * camera_from_world[p];
+  }
+
+  // The bundle: boards of frames seen by a kept camera, from the camera that saw most corners.
+  BundleProblem problem;
+  std::vector<std::optional<std::size_t>> board_index(frames);
+  std::vector<std::size_t> frame_of_board;
+  for (std::size_t f = 0; f < frames; ++f) {
+    std::optional<std::size_t> best;
+    for (std::size_t i : kept)
+      if (board_in_camera[i][f] &&
+          (!best || views[i]->boards[f]->pixels.size() > views[*best]->boards[f]->pixels.size()))
+        best = i;
+    if (!best) continue;
+    board_index[f] = problem.board_poses.size();
+    frame_of_board.push_back(f);
+    problem.board_poses.push_back(
+        pose_of(camera_from_world[*best].inverse() * *board_in_camera[*best][f]));
+  }
+  std::vector<std::size_t> kept_position(views.size());
+  for (std::size_t k = 0; k < kept.size(); ++k) {
+    const std::size_t i = kept[k];
+    kept_position[i] = k;
+    problem.cameras.push_back(cameras[i]);
+    problem.camera_poses.push_back(pose_of(camera_from_world[i]));
+    for (std::size_t f = 0; f < frames; ++f) {
+      if (!board_in_camera[i][f]) continue;
+      const BoardObservation& b = *views[i]->boards[f];
+      for (std::size_t c = 0; c < b.pixels.size(); ++c)
+        problem.corners.push_back(
+            {k,
+             *board_index[f],
+             {b.object_mm[c][0] / 1000, b.object_mm[c][1] / 1000, b.object_mm[c][2] / 1000},
+             b.pixels[c],
+             true});
+    }
+  }
+  problem.fixed_camera = kept_position[graph.root];
+  problem.refine_intrinsics = options.refine_intrinsics;
+
+  std::vector<double> errors;
+  for (int round = 0; round <= options.outlier_rounds; ++round) {
+    report(options, "bundle adjustment", static_cast<double>(round) / (options.outlier_rounds + 1));
+    bundle_adjust(problem, errors);
+    if (round == options.outlier_rounds) break;
+    std::vector<double> active;
+    for (double e : errors)
+      if (std::isfinite(e)) active.push_back(e);
+    // Never below half a pixel: on clean data 3x the median would cut into the good corners.
+    const double limit = std::max(options.outlier_factor * median(active), 0.5);
+    bool dropped = false;
+    for (std::size_t c = 0; c < errors.size(); ++c)
+      if (std::isfinite(errors[c]) && errors[c] > limit)
+        problem.corners[c].active = false, dropped = true;
+    if (!dropped) break;
+  }
+  report(options, "bundle adjustment", 1.0);
+
+  // The floor frame.
+  int floor = options.floor_frame;
+  if (floor < 0) {
+    floor = static_cast<int>(frame_of_board.front());
+  } else if (static_cast<std::size_t>(floor) >= frames ||
+             !board_index[static_cast<std::size_t>(floor)]) {
+    throw InputError("floor frame " + std::to_string(floor),
+                     static_cast<std::size_t>(floor) >= frames
+                         ? "the views have " + std::to_string(frames) + " frames"
+                         : "no camera of the rig saw the board in this frame (try every frame: "
+                           "step 1)");
+  }
+  const Rigid world_from_old =
+      world_from_floor_board() *
+      rigid(problem.board_poses[*board_index[static_cast<std::size_t>(floor)]]).inverse();
+  const Rigid old_from_world = world_from_old.inverse();
+
+  // The rig and its report.
+  double all_squared = 0.0;
+  int all_count = 0;
+  for (std::size_t k = 0; k < kept.size(); ++k) {
+    Camera c = problem.cameras[k];
+    const Rigid pose = rigid(problem.camera_poses[k]) * old_from_world;
+    c.rotation = to_glm(pose.R);
+    c.translation = {pose.t[0], pose.t[1], pose.t[2]};
+    result.rig.cameras.push_back(c);
+    CameraCalibrationReport r;
+    r.name = c.name;
+    r.frames_with_board = seen[kept[k]];
+    r.intrinsics_rms_px = intrinsic_rms[kept[k]];
+    double squared = 0.0;
+    for (std::size_t o = 0; o < problem.corners.size(); ++o) {
+      if (problem.corners[o].camera != k) continue;
+      if (!problem.corners[o].active) {
+        ++r.dropped;
+        continue;
+      }
+      ++r.observations;
+      squared += errors[o] * errors[o];
+    }
+    all_squared += squared;
+    all_count += r.observations;
+    r.rms_px = r.observations ? std::sqrt(squared / r.observations) : 0.0;
+    result.cameras.push_back(r);
+  }
+  result.rig.floor = GroundPlane{{0.0, 0.0, 1.0}, options.board_thickness_mm / 1000.0};
+  result.floor_frame = floor;
+  result.frames_used = static_cast<int>(frame_of_board.size());
+  result.rms_px = all_count ? std::sqrt(all_squared / all_count) : 0.0;
+  return result;
+}
+
+RigCalibration calibrate_rig_from_board(const std::vector<std::string>& views,
+                                        const std::vector<std::string>& names,
+                                        const RigBoardOptions& options) {
+  return calibrate_rig(find_rig_board(views, names, options), options);
+}
+
+}  // namespace mocap::camera

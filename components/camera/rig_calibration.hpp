@@ -1,0 +1,140 @@
+#pragma once
+// Calibrating several cameras together from a board they all film (`mocap calibrate rig`,
+// docs/cameras.md "Calibrating a rig from a board"):
+//
+//   1. the board's corners per camera per frame (the views are in step: frame i of every view was
+//      taken at the same instant);
+//   2. intrinsics per camera, from its own frames, or given (`RigBoardOptions::intrinsics`);
+//   3. the board's pose in every camera that saw it (PnP), then an initial camera graph: relative
+//      poses from the frames two cameras share, chained over the spanning tree that keeps the
+//      pairs with the most shared frames;
+//   4. one bundle adjustment (Ceres, rig_bundle_adjustment.cpp) over all camera poses and board
+//      poses (the intrinsics too with `refine_intrinsics`); observations whose error exceeds
+//      `outlier_factor` x the median are dropped and the solve repeated;
+//   5. the world from the board lying on the floor in `floor_frame`: origin at the board's origin,
+//      x along the board's x, z up (away from the floor), metres from the square size.
+
+#include <array>
+#include <cstddef>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "camera/board.hpp"
+#include "camera/rig.hpp"
+
+namespace mocap::camera {
+
+// The board as one camera saw it in one frame.
+struct BoardObservation {
+  std::vector<std::array<double, 3>> object_mm;  // board frame, millimetres, z = 0
+  std::vector<std::array<double, 2>> pixels;     // distorted image pixels
+};
+
+// What was found in one camera's view (a video or a folder of images).
+struct CameraBoardViews {
+  std::string name;    // the camera's name in the rig
+  std::string source;  // the video or folder, for messages
+  int width = 0, height = 0;
+  int frames = 0;  // frames in the view (every one counted, whatever the step)
+  int tried = 0;   // frames searched for the board
+  std::vector<std::optional<BoardObservation>> boards;  // per frame; empty where not found
+};
+
+struct RigBoardOptions {
+  BoardSpec board;
+  int step = 1;         // search every step-th frame of each view
+  int min_corners = 6;  // ChArUco: fewer corners in a view -> not found there
+  // Intrinsics (matrix, distortion, size) per camera by name; extrinsics are ignored. Empty:
+  // each camera is calibrated from its own frames (at least min_intrinsic_views of them).
+  std::optional<Rig> intrinsics;
+  std::string intrinsics_source = "the intrinsics rig";  // its file, for messages
+  int min_intrinsic_views = 4;
+  bool refine_intrinsics = false;  // also adjust fx fy cx cy k1 k2 p1 p2 in the bundle
+  double outlier_factor = 3.0;     // drop observations with error > factor x median, re-solve
+  int outlier_rounds = 2;
+  // The frame in which the board lies flat on the floor; -1: the first frame in which any
+  // camera of the rig sees the board.
+  int floor_frame = -1;
+  double board_thickness_mm = 0.0;  // the floor is this far below the board's face
+  // Cameras that share no frame with the others: refused (InputError naming them), or with
+  // `drop_unconnected` left out of the rig (RigCalibration::notes says which).
+  bool drop_unconnected = false;
+  // Progress of long steps: what (e.g. "cam_02: finding the board"), fraction done in [0, 1].
+  std::function<void(const std::string& stage, double fraction)> progress;
+};
+
+struct CameraCalibrationReport {
+  std::string name;
+  int frames_with_board = 0;       // frames in which the board was found
+  int observations = 0;            // corners used in the final solve
+  int dropped = 0;                 // corners dropped as outliers
+  double rms_px = 0.0;             // RMS reprojection error over the corners used
+  double intrinsics_rms_px = 0.0;  // of its own intrinsic calibration (0 when given)
+};
+
+struct RigCalibration {
+  Rig rig;                                       // cameras in view order, world and floor
+  std::vector<CameraCalibrationReport> cameras;  // the same order
+  int floor_frame = 0;
+  int frames_used = 0;             // frames with the board in at least one camera of the rig
+  double rms_px = 0.0;             // over all corners used
+  std::vector<std::string> notes;  // what a user should know (cameras left out, ...)
+};
+
+// Reads each view (a video file, or a folder of images in name order) and finds the board in every
+// options.step-th frame. Throws InputError naming the view when it cannot be read (no such file, a
+// folder without images, a video that does not open, an image that does not decode or whose size
+// differs), and when the views have different frame counts (naming each view's count: the views
+// must be in step, so nothing is guessed).
+std::vector<CameraBoardViews> find_rig_board(const std::vector<std::string>& views,
+                                             const std::vector<std::string>& names,
+                                             const RigBoardOptions& options);
+
+// Calibrates the rig from the boards found. Throws InputError naming the camera when the board was
+// never (or too rarely, without intrinsics) found in it, with the number of frames tried; naming
+// the cameras that share no frame with the others (unless drop_unconnected); naming the floor
+// frame when no camera saw the board there; naming a camera missing from options.intrinsics or
+// whose size differs there.
+RigCalibration calibrate_rig(const std::vector<CameraBoardViews>& views,
+                             const RigBoardOptions& options);
+
+// Both: the rig from the views.
+RigCalibration calibrate_rig_from_board(const std::vector<std::string>& views,
+                                        const std::vector<std::string>& names,
+                                        const RigBoardOptions& options);
+
+// Pieces, public for the tests.
+namespace rig_calibration_detail {
+
+// A rigid transform x' = R x + t (R as a Rodrigues vector), metres.
+struct Pose {
+  std::array<double, 3> rotation{};
+  std::array<double, 3> translation{};
+};
+
+// One corner seen by one camera in one frame.
+struct CornerObservation {
+  std::size_t camera = 0;
+  std::size_t frame = 0;  // index into the board poses
+  std::array<double, 3> object_m{};
+  std::array<double, 2> pixel{};
+  bool active = true;  // false once dropped as an outlier
+};
+
+struct BundleProblem {
+  std::vector<Camera> cameras;     // intrinsics; pose ignored (see camera_poses)
+  std::vector<Pose> camera_poses;  // world -> camera
+  std::vector<Pose> board_poses;   // board -> world
+  std::vector<CornerObservation> corners;
+  std::size_t fixed_camera = 0;  // its pose is held (the gauge)
+  bool refine_intrinsics = false;
+};
+
+// Solves in place (Ceres, rig_bundle_adjustment.cpp); returns each active corner's reprojection
+// error (px) in `errors` (inactive: NaN).
+void bundle_adjust(BundleProblem& problem, std::vector<double>& errors);
+
+}  // namespace rig_calibration_detail
+}  // namespace mocap::camera

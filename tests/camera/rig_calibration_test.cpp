@@ -1,0 +1,245 @@
+// Calibrating a rig from a board (camera/rig_calibration.hpp) on SYNTHETIC renders: four virtual
+// cameras around a 4 m room, a ChArUco board in a few places (support/virtual_rig.hpp), the truth
+// known. Small images and few frames, so it takes seconds; tools/bench/rig_board_bench.cpp has the
+// full 4- and 8-camera tables. Then the bad inputs: a board never found, a camera that shares no
+// frame, views of different lengths, unreadable views, an intrinsics rig without a camera.
+
+#include "camera/rig_calibration.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include <glm/geometric.hpp>
+#include <glm/gtc/matrix_access.hpp>
+
+#include "core/input_error.hpp"
+#include "support/files.hpp"
+#include "support/virtual_rig.hpp"
+
+namespace mocap::camera {
+namespace {
+
+namespace fs = std::filesystem;
+
+double rotation_error_deg(const glm::dmat3& a, const glm::dmat3& b) {
+  const glm::dmat3 d = a * glm::transpose(b);
+  const double trace = d[0][0] + d[1][1] + d[2][2];
+  return std::acos(std::clamp((trace - 1) / 2, -1.0, 1.0)) * 180.0 / std::acos(-1.0);
+}
+
+std::vector<std::string> names_of(const std::vector<Camera>& cameras) {
+  std::vector<std::string> names;
+  for (const Camera& c : cameras) names.push_back(c.name);
+  return names;
+}
+
+// Four cameras, eight frames, rendered once for every test here.
+class RigCalibration : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = std::make_unique<test::TempDir>();
+    room_.cameras = 4;
+    room_.frames = 16;
+    room_.seed = 3;
+    room_.width = 960;
+    room_.height = 540;
+    truth_ = test::make_virtual_rig(room_);
+    folders_ = test::render_virtual_rig(truth_, room_, dir_->path());
+    options_.board = room_.board;
+    Rig intrinsics;
+    intrinsics.cameras = truth_.cameras;
+    options_.intrinsics = intrinsics;
+    views_ = find_rig_board(folders_, names_of(truth_.cameras), options_);
+  }
+  static void TearDownTestSuite() { dir_.reset(); }
+
+  static inline std::unique_ptr<test::TempDir> dir_;
+  static inline test::VirtualRoom room_;
+  static inline test::VirtualRig truth_;
+  static inline std::vector<std::string> folders_;
+  static inline RigBoardOptions options_;
+  static inline std::vector<CameraBoardViews> views_;
+};
+
+TEST_F(RigCalibration, RecoversFourCamerasAndTheFloor) {
+  for (std::size_t k = 0; k < views_.size(); ++k) {
+    int found = 0, shown = 0;
+    for (std::size_t f = 0; f < views_[k].boards.size(); ++f) {
+      found += views_[k].boards[f].has_value();
+      shown += truth_.seen[k][f];
+    }
+    EXPECT_EQ(views_[k].frames, room_.frames);
+    // The detector may miss an oblique board, never invent one.
+    EXPECT_LE(found, shown) << views_[k].name;
+    EXPECT_GE(found, 2) << views_[k].name;
+  }
+  const camera::RigCalibration result = calibrate_rig(views_, options_);
+  ASSERT_EQ(result.rig.cameras.size(), 4u);
+  EXPECT_EQ(result.floor_frame, 0);
+  ASSERT_TRUE(result.rig.floor);
+  EXPECT_EQ(result.rig.floor->normal, glm::dvec3(0, 0, 1));
+  for (std::size_t k = 0; k < 4; ++k) {
+    const Camera& got = result.rig.cameras[k];
+    const Camera& want = truth_.cameras[k];
+    const double mm = 1000.0 * glm::length(got.centre() - want.centre());
+    const double deg = rotation_error_deg(got.rotation, want.rotation);
+    std::cout << got.name << ": position error " << mm << " mm, angle " << deg << " deg, RMS "
+              << result.cameras[k].rms_px << " px, " << result.cameras[k].dropped
+              << " corners dropped\n";
+    EXPECT_EQ(got.name, want.name);
+    EXPECT_LT(mm, 10.0) << got.name;
+    EXPECT_LT(deg, 0.3) << got.name;
+    EXPECT_LT(result.cameras[k].rms_px, 0.5) << got.name;
+    EXPECT_GT(result.cameras[k].observations, 0);
+  }
+  EXPECT_TRUE(result.notes.empty());
+}
+
+TEST_F(RigCalibration, ACameraThatSharesNoFrameIsNamedOrLeftOut) {
+  std::vector<CameraBoardViews> views = views_;
+  // cam_04 keeps none of the frames it shares, and sees the board alone in one more frame.
+  for (std::size_t f = 0; f < views[3].boards.size(); ++f)
+    if (views[0].boards[f] || views[1].boards[f] || views[2].boards[f]) views[3].boards[f].reset();
+  for (auto& v : views) v.boards.emplace_back();
+  ASSERT_TRUE(views_[3].boards[0]) << "cam_04 does not see the floor board";
+  views[3].boards.back() = views_[3].boards[0];
+  try {
+    calibrate_rig(views, options_);
+    FAIL() << "a camera sharing no frame was accepted";
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("cam_04"), std::string::npos) << what;
+    EXPECT_NE(what.find("never see the board"), std::string::npos) << what;
+    EXPECT_EQ(what.find("cam_01 ("), std::string::npos) << what;
+  }
+  RigBoardOptions drop = options_;
+  drop.drop_unconnected = true;
+  const camera::RigCalibration result = calibrate_rig(views, drop);
+  EXPECT_EQ(names_of(result.rig.cameras), (std::vector<std::string>{"cam_01", "cam_02", "cam_03"}));
+  ASSERT_EQ(result.notes.size(), 1u);
+  EXPECT_NE(result.notes[0].find("cam_04"), std::string::npos);
+}
+
+TEST_F(RigCalibration, ABoardNeverFoundNamesTheCameraAndTheFramesTried) {
+  // A fifth camera whose folder shows an empty room.
+  const fs::path empty = dir_->path() / "empty";
+  fs::create_directories(empty);
+  for (int f = 0; f < room_.frames; ++f)
+    cv::imwrite((empty / ("frame_" + std::to_string(100 + f) + ".png")).string(),
+                cv::Mat(room_.height, room_.width, CV_8U, cv::Scalar(110)));
+  // Two views are enough to say it (and quicker to read).
+  const std::vector<std::string> folders{folders_[0], empty.string()};
+  const std::vector<std::string> names{"cam_01", "cam_05"};
+  Rig intrinsics = *options_.intrinsics;
+  intrinsics.cameras.push_back(truth_.cameras[0]);
+  intrinsics.cameras.back().name = "cam_05";
+  RigBoardOptions options = options_;
+  options.intrinsics = intrinsics;
+  try {
+    calibrate_rig_from_board(folders, names, options);
+    FAIL() << "a camera without the board was accepted";
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("cam_05"), std::string::npos) << what;
+    EXPECT_NE(what.find(empty.string()), std::string::npos) << what;
+    EXPECT_NE(
+        what.find("not found in any of the " + std::to_string(room_.frames) + " frames tried"),
+        std::string::npos)
+        << what;
+  }
+}
+
+TEST_F(RigCalibration, ViewsOfDifferentLengthsAreRefusedWithTheirCounts) {
+  const fs::path shorter = dir_->path() / "shorter";
+  fs::create_directories(shorter);
+  for (int f = 0; f + 1 < room_.frames; ++f) {
+    char name[32];
+    std::snprintf(name, sizeof name, "frame_%03d.png", f);
+    fs::copy_file(fs::path(folders_[1]) / name, shorter / name,
+                  fs::copy_options::overwrite_existing);
+  }
+  const std::vector<std::string> folders{folders_[0], shorter.string()};
+  try {
+    find_rig_board(folders, {"cam_01", "cam_02"}, options_);
+    FAIL() << "views of different lengths were accepted";
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("different frame counts"), std::string::npos) << what;
+    EXPECT_NE(what.find("cam_02 (" + shorter.string() + ") " + std::to_string(room_.frames - 1)),
+              std::string::npos)
+        << what;
+    EXPECT_NE(what.find("cam_01 (" + folders_[0] + ") " + std::to_string(room_.frames)),
+              std::string::npos)
+        << what;
+  }
+}
+
+// Without the rendered room: the bad view is read first and refused before the other.
+TEST(RigCalibrationViews, UnreadableViewsAreNamed) {
+  test::TempDir dir;
+  RigBoardOptions options;
+  options.board = test::VirtualRoom{}.board;
+  const std::string missing = dir.file("no-such-view");
+  const std::string not_video = dir.file("garbage.mp4");
+  test::write_file(not_video, "this is not a video");
+  const fs::path folder_with_garbage = dir.path() / "garbage-images";
+  fs::create_directories(folder_with_garbage);
+  test::write_file((folder_with_garbage / "frame_000.png").string(), "not a png");
+  const fs::path no_images = dir.path() / "no-images";
+  fs::create_directories(no_images);
+  for (const std::string& bad :
+       {missing, not_video, (folder_with_garbage / "frame_000.png").string(), no_images.string()}) {
+    // The bad view first: the good ones after it are not read.
+    const std::vector<std::string> folders{bad == (folder_with_garbage / "frame_000.png").string()
+                                               ? folder_with_garbage.string()
+                                               : bad,
+                                           dir.file("never-read")};
+    try {
+      find_rig_board(folders, {"cam_03", "cam_01"}, options);
+      ADD_FAILURE() << bad << " was accepted";
+    } catch (const InputError& e) {
+      const std::string what = e.what();
+      EXPECT_EQ(what.rfind(bad + ": ", 0), 0u) << what;
+      EXPECT_NE(what.find("cam_03"), std::string::npos) << what;
+    }
+  }
+}
+
+TEST_F(RigCalibration, AnIntrinsicsRigWithoutACameraNamesIt) {
+  RigBoardOptions options = options_;
+  options.intrinsics->cameras.erase(options.intrinsics->cameras.begin() + 2);
+  options.intrinsics_source = "given.toml";
+  try {
+    calibrate_rig(views_, options);
+    FAIL() << "a missing camera was accepted";
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(what.rfind("given.toml: has no camera 'cam_03'", 0), 0u) << what;
+    EXPECT_NE(what.find("it has cam_01, cam_02, cam_04"), std::string::npos) << what;
+  }
+}
+
+TEST_F(RigCalibration, AFloorFrameWithoutTheBoardIsNamed) {
+  RigBoardOptions options = options_;
+  options.floor_frame = 99;
+  try {
+    calibrate_rig(views_, options);
+    FAIL() << "floor frame 99 was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("floor frame 99: the views have " +
+                                         std::to_string(room_.frames) + " frames"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace mocap::camera

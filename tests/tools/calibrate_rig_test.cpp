@@ -1,0 +1,86 @@
+// `mocap calibrate rig` driven as a user would: the built binary in a child process, on
+// SYNTHETIC renders of a ChArUco board seen by four virtual cameras (support/virtual_rig.hpp),
+// the intrinsics given as a rig file. The library's accuracy and its bad inputs are in
+// tests/camera/rig_calibration_test.cpp; here: the command's table, the file it writes, and its
+// messages for an intrinsics rig without a camera and for an unreadable view.
+
+#include <filesystem>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include <glm/geometric.hpp>
+
+#include "camera/rig_file.hpp"
+#include "support/mocap_process.hpp"
+#include "support/virtual_rig.hpp"
+
+namespace mocap {
+namespace {
+
+using namespace std::chrono_literals;
+
+TEST(CalibrateRigCommand, WritesTheRigOfFourVirtualCameras) {
+  test::TempDir dir;
+  test::VirtualRoom room;
+  room.cameras = 4;
+  room.frames = 10;
+  room.width = 960;
+  room.height = 540;
+  room.seed = 5;
+  test::VirtualRig truth = test::make_virtual_rig(room);
+  const std::vector<std::string> views =
+      test::render_virtual_rig(truth, room, dir.path() / "views");
+  camera::write_rig(dir.file("lenses.toml"), camera::Rig{truth.cameras, std::nullopt});
+
+  std::vector<std::string> command{"calibrate", "rig"};
+  command.insert(command.end(), views.begin(), views.end());
+  for (const char* option : {"--board", "charuco", "--squares", "6x4", "--square", "150",
+                             "--marker", "110", "--intrinsics"})
+    command.emplace_back(option);
+  command.push_back(dir.file("lenses.toml"));
+  command.emplace_back("--out");
+  command.push_back(dir.file("rig.toml"));
+  test::Mocap run(dir, "rig", command);
+  ASSERT_EQ(run.wait(120s), 0) << run.err();
+  const std::string out = run.out();
+  std::cout << out;
+  for (const char* text : {"ChArUco 6x4 squares of 150 mm", "the floor from frame 0", "| cam_04 |",
+                           "RMS reprojection error", "wrote"})
+    EXPECT_NE(out.find(text), std::string::npos) << text << "\n" << out;
+  const camera::Rig rig = camera::read_rig(dir.file("rig.toml"));
+  ASSERT_EQ(rig.cameras.size(), 4u);
+  ASSERT_TRUE(rig.floor);
+  for (std::size_t k = 0; k < 4; ++k) {
+    EXPECT_EQ(rig.cameras[k].name, truth.cameras[k].name);
+    // Loose: ten frames of small images; the benchmark measures the accuracy.
+    EXPECT_LT(glm::length(rig.cameras[k].centre() - truth.cameras[k].centre()), 0.03)
+        << rig.cameras[k].name;
+  }
+
+  // An intrinsics rig with three cameras for four views names the view without a camera.
+  camera::write_rig(
+      dir.file("three.toml"),
+      camera::Rig{{truth.cameras[0], truth.cameras[1], truth.cameras[2]}, std::nullopt});
+  command[command.size() - 3] = dir.file("three.toml");
+  test::Mocap missing(dir, "missing", command);
+  EXPECT_NE(missing.wait(60s), 0);
+  EXPECT_NE(missing.err().find(dir.file("three.toml") + ": has 3 cameras, no camera for view 4 (" +
+                               views[3] + ")"),
+            std::string::npos)
+      << missing.err();
+
+  // A view that is not there is named.
+  command[command.size() - 3] = dir.file("lenses.toml");
+  command[3] = dir.file("nowhere");
+  test::Mocap unreadable(dir, "unreadable", command);
+  EXPECT_NE(unreadable.wait(60s), 0);
+  EXPECT_NE(unreadable.err().find(dir.file("nowhere") + ": no such file or folder (camera cam_02)"),
+            std::string::npos)
+      << unreadable.err();
+}
+
+}  // namespace
+}  // namespace mocap
