@@ -173,6 +173,29 @@ TEST_F(ReconstructMultiView, Pose2SimDemoAgreesWithItsTrcAndTheBvhStandsOnTheFlo
   }
   EXPECT_GT(lowest, -0.05f) << "the feet go under the floor";
   EXPECT_LT(lowest, 0.15f) << "the feet float above the floor";
+
+  // The participant's TRC: Pose2Sim's Y-up axes (eval::trc_to_world turns them back), one row
+  // per input frame from the person's first (Frame# = frame + 1), the head where joints_world
+  // has it.
+  const io::TrcFile ours =
+      io::read_trc(dir_.file("demo") + "/person_" + std::to_string(participant) + ".trc");
+  ASSERT_EQ(ours.markers.size(), 15u);
+  ASSERT_TRUE(ours.marker("Head").has_value());
+  int first = -1, compared = 0;
+  for (int f = 0; f < kFrames; ++f) {
+    for (const json& person : frames[static_cast<std::size_t>(f)]["people"]) {
+      if (person["id"] != participant) continue;
+      if (first < 0) first = f;
+      if (person["joints_world"]["head"][0].is_null()) continue;
+      ASSERT_LT(static_cast<std::size_t>(f - first), ours.frames.size());
+      const glm::vec3 head = glm::vec3(eval::trc_to_world(
+          ours.frames[static_cast<std::size_t>(f - first)][*ours.marker("Head")]));
+      EXPECT_LT(glm::distance(head, vec(person["joints_world"]["head"])), 0.002f) << "frame " << f;
+      ++compared;
+    }
+  }
+  EXPECT_EQ(ours.frames.size(), static_cast<std::size_t>(kFrames - first));
+  EXPECT_GT(compared, kFrames / 2);
 }
 
 TEST_F(ReconstructMultiView, ARigThatDisagreesWithTheViewsIsRefusedNamingTheCamera) {

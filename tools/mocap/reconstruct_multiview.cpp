@@ -142,7 +142,8 @@ std::string quoted(const std::string& text) { return json(text).dump(); }
 
 // The graph of graphs/multiview_json.yaml (and its video form) for these views.
 std::string graph_text(const std::vector<View>& views, const std::string& rig_file,
-                       const fs::path& out, double fps, const std::string& detector) {
+                       const fs::path& out, double fps, const std::string& detector,
+                       const std::string& trc_world_up) {
   const std::string rate = json(fps).dump();
   std::ostringstream g;
   g << "graph: multiview_reconstruct\nnodes:\n";
@@ -167,7 +168,9 @@ std::string graph_text(const std::vector<View>& views, const std::string& rig_fi
     << "  jsonl: { type: sink.jsonl, params: { path: " << quoted((out / "poses.jsonl").string())
     << " } }\n"
     << "  bvh: { type: sink.bvh_joints, params: { dir: " << quoted(out.string())
-    << ", fps: " << rate << " } }\nedges:\n";
+    << ", fps: " << rate << " } }\n"
+    << "  trc: { type: sink.trc, params: { path: " << quoted((out / "person_{id}.trc").string())
+    << ", fps: " << rate << ", world_up: " << trc_world_up << " } }\nedges:\n";
   for (std::size_t i = 0; i < views.size(); ++i) {
     if (views[i].kind == ViewKind::openpose_json) {
       g << "  - [view_" << i << ".out, solve.view:" << i << "]\n";
@@ -176,7 +179,7 @@ std::string graph_text(const std::vector<View>& views, const std::string& rig_fi
         << "  - [detect_" << i << ".out, solve.view:" << i << "]\n";
     }
   }
-  g << "  - [solve.out, jsonl.in]\n  - [solve.out, bvh.in]\n";
+  g << "  - [solve.out, jsonl.in]\n  - [solve.out, bvh.in]\n  - [solve.out, trc.in]\n";
   return g.str();
 }
 
@@ -200,7 +203,9 @@ int reconstruct_multiview_command(int argc, char** argv) {
       "per frame set: per person the track id and the 15 joints, metres, under joints_world in\n"
       "the rig's world), person_<id>.bvh per person (a humanoid skeleton with the person's bone\n"
       "lengths, y up, the floor at y = 0: the rig's floor, else the plane through its origin\n"
-      "across the cameras' up axis, e.g. z = 0 for Pose2Sim) and summary.json. People seen by one\n"
+      "across the cameras' up axis, e.g. z = 0 for Pose2Sim), person_<id>.trc per person (the 15\n"
+      "joints as markers, Y up as Pose2Sim writes them, for OpenSim) and summary.json. People seen "
+      "by one\n"
       "camera only are dropped and counted. A view's unreadable frames are named and the others\n"
       "go on; views of different lengths go on with the views left (counted as missing).\n"
       "DIR holding an earlier run's output is refused unless --force (as without --calibration).");
@@ -250,11 +255,15 @@ int reconstruct_multiview_command(int argc, char** argv) {
   }
   if (fps <= 0.0) fps = 30.0;
   std::string floor_how;
-  (void)multiview::rig_floor(rig, &floor_how);
+  const GroundPlane floor = multiview::rig_floor(rig, &floor_how);
+  // TRC files are Y-up (OpenSim): a world whose floor is level in x-y (Pose2Sim's, a board's) is
+  // turned as Pose2Sim turns it; one already y-up is written as it is.
+  const std::string trc_world_up = std::abs(floor.normal.y) > std::abs(floor.normal.z) ? "y" : "z";
 
   graph::load_plugins_from_environment();
   graph::GraphSpec spec = graph::parse_graph_text(
-      graph_text(views, rig_file, out, fps, args.get("detector")), "mocap reconstruct");
+      graph_text(views, rig_file, out, fps, args.get("detector"), trc_world_up),
+      "mocap reconstruct");
   graph::apply_overrides(spec, args.all("set"));
   check_detector_model(spec);
   const graph::ResolvedGraph resolved = graph::resolve(std::move(spec));
