@@ -36,6 +36,16 @@ std::string ground_problem(const GroundPlane& p) {
   return {};
 }
 
+std::optional<glm::dvec3> cameras_up(const Rig& rig) {
+  glm::dvec3 up(0.0);
+  // Row 1 of R (world -> camera) is the camera's y axis in the world.
+  for (const Camera& c : rig.cameras)
+    up -= glm::dvec3(c.rotation[0][1], c.rotation[1][1], c.rotation[2][1]);
+  const double length = glm::length(up);
+  if (!(length > 1e-9) || !std::isfinite(length)) return std::nullopt;
+  return up / length;
+}
+
 std::string rig_problem(const Rig& rig) {
   if (rig.cameras.empty()) return "no camera";
   for (std::size_t i = 0; i < rig.cameras.size(); ++i) {

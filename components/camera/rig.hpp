@@ -25,6 +25,11 @@ struct Rig {
   bool operator==(const Rig&) const = default;
 };
 
+// Which way is up, judged from the cameras alone (they are mounted upright: their image y axis
+// points down in the world): the unit mean of their up directions, or nullopt without cameras
+// or when those cancel out. For a rig without a floor.
+std::optional<glm::dvec3> cameras_up(const Rig& rig);
+
 // Why the rig cannot be used (no camera, a camera_problem(), a name used twice, a floor whose
 // normal is not a unit vector or that is not finite), or empty. The answer names the camera.
 std::string rig_problem(const Rig& rig);

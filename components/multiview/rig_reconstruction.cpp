@@ -25,9 +25,7 @@ GroundPlane rig_floor(const camera::Rig& rig, std::string* how) {
     if (how) *how = "the rig's floor";
     return *rig.floor;
   }
-  // Cameras stand upright: their image y axis (down) points roughly down in the world.
-  glm::dvec3 up(0.0);
-  for (const camera::Camera& c : rig.cameras) up -= glm::transpose(c.rotation)[1];
+  const glm::dvec3 up = camera::cameras_up(rig).value_or(glm::dvec3(0.0, 0.0, 1.0));
   int axis = 2;
   for (int a = 0; a < 3; ++a) {
     if (std::abs(up[a]) > std::abs(up[axis])) axis = a;

@@ -101,10 +101,7 @@ Json posed_camera_json(const camera::Camera& c) {
 glm::dvec3 world_up(const People3D& frame, const camera::Rig& rig) {
   if (frame.has_ground) return frame.ground.normal;
   if (rig.floor) return rig.floor->normal;
-  glm::dvec3 down(0.0);
-  for (const camera::Camera& c : rig.cameras)
-    down += glm::dvec3(c.rotation[0][1], c.rotation[1][1], c.rotation[2][1]);
-  if (const double length = glm::length(down); length > 1e-9) return -down / length;
+  if (const std::optional<glm::dvec3> up = camera::cameras_up(rig)) return *up;
   glm::dvec3 up(0.0);  // no camera: people stand upright
   for (const Person3D& p : frame.people)
     up += glm::dvec3(p.positions[index(Joint::neck)] - p.positions[index(Joint::root)]);
