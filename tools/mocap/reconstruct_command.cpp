@@ -424,6 +424,40 @@ std::string incomplete_note(const WrittenOutputs& written, const json& summary,
   return note.str();
 }
 
+ReconstructRun run_reconstruct_graph(const graph::ResolvedGraph& graph,
+                                     const graph::RunOptions& options,
+                                     const ProgressCallback& progress, ProgressBar& bar,
+                                     EarlierOutput& earlier, const fs::path& out, bool quiet,
+                                     std::chrono::steady_clock::time_point started) {
+  ReconstructRun run;
+  try {
+    run.result = run_graph_here(graph, options, "mocap reconstruct", progress);
+  } catch (...) {
+    std::vector<fs::path> files = reconstruct_outputs_in(out);
+    std::erase_if(files, [](const fs::path& f) { return f.filename() == "summary.json"; });
+    earlier.settle(!files.empty());
+    throw;
+  }
+  bar.finish();
+  run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  if (!quiet) std::cerr << graph::format_stats_table(run.result.stats);
+  run.files = reconstruct_outputs_in(out);
+  std::erase_if(run.files, [](const fs::path& f) { return f.filename() == "summary.json"; });
+  run.written = classify_outputs(run.files);
+  const bool wrote_output = !run.files.empty();
+  const bool earlier_put_back = earlier.count() > 0 && !wrote_output;
+  if (const std::string note = earlier.settle(wrote_output); !note.empty())
+    std::cerr << "mocap reconstruct: " << note << "\n";
+  const graph::RunResult& r = run.result;
+  run.outcome = !r.ok ? "failed: " + r.error : r.stopped ? std::string("interrupted") : "";
+  if (earlier_put_back || (!wrote_output && !run.outcome.empty())) {
+    if (!run.outcome.empty()) std::cerr << "mocap reconstruct: " << run.outcome << "\n";
+    std::cerr << "mocap reconstruct: nothing was written into " << out.string() << "\n";
+    run.nothing_written = !r.ok ? 1 : r.stopped ? 130 : 0;
+  }
+  return run;
+}
+
 json node_latency(const graph::GraphStats& stats) {
   json nodes = json::object();
   for (const auto& n : stats.nodes) {
@@ -591,38 +625,14 @@ int reconstruct_command(int argc, char** argv) {
       }
     };
   }
-  graph::RunResult result;
-  try {
-    result = run_graph_here(resolved, options, "mocap reconstruct", progress);
-  } catch (...) {
-    std::vector<fs::path> files = reconstruct_outputs_in(out);
-    std::erase_if(files, [](const fs::path& f) { return f.filename() == "summary.json"; });
-    earlier.settle(!files.empty());
-    throw;
-  }
-  bar.finish();
-  const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-  if (!args.has("quiet")) std::cerr << graph::format_stats_table(result.stats);
-
-  // Every output file in DIR now is this run's: earlier ones were refused or set aside.
-  std::vector<fs::path> files = reconstruct_outputs_in(out);
-  std::erase_if(files, [](const fs::path& f) { return f.filename() == "summary.json"; });
-  const WrittenOutputs written = classify_outputs(files);
-  const bool wrote_output = !files.empty();
-  const bool earlier_put_back = earlier.count() > 0 && !wrote_output;
-  if (const std::string note = earlier.settle(wrote_output); !note.empty())
-    std::cerr << "mocap reconstruct: " << note << "\n";
-  const std::string outcome = !result.ok       ? "failed: " + result.error
-                              : result.stopped ? std::string("interrupted")
-                                               : std::string();
-  if (earlier_put_back || (!wrote_output && !outcome.empty())) {
-    // A run that wrote nothing writes no summary either: the folder stays as it was (an earlier
-    // output is back, its summary.json with it).
-    if (!outcome.empty()) std::cerr << "mocap reconstruct: " << outcome << "\n";
-    std::cerr << "mocap reconstruct: nothing was written into " << out.string() << "\n";
-    return !result.ok ? 1 : result.stopped ? 130 : 0;
-  }
+  const ReconstructRun run = run_reconstruct_graph(resolved, options, progress, bar, earlier, out,
+                                                   args.has("quiet"), started);
+  if (run.nothing_written) return *run.nothing_written;
+  const graph::RunResult& result = run.result;
+  const double seconds = run.seconds;
+  const std::vector<fs::path>& files = run.files;
+  const WrittenOutputs& written = run.written;
+  const std::string& outcome = run.outcome;
   json summary = summarize_output(out / "poses.jsonl");
   summary["input"] = input;
   summary["database"] = args.get("db");

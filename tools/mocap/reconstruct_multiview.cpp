@@ -280,35 +280,14 @@ int reconstruct_multiview_command(int argc, char** argv) {
         bar.update("reconstruct", static_cast<double>(n.in) / static_cast<double>(frames));
     }
   };
-  graph::RunResult result;
-  try {
-    result = run_graph_here(resolved, options, "mocap reconstruct", progress);
-  } catch (...) {
-    std::vector<fs::path> files = reconstruct_outputs_in(out);
-    std::erase_if(files, [](const fs::path& f) { return f.filename() == "summary.json"; });
-    earlier.settle(!files.empty());
-    throw;
-  }
-  bar.finish();
-  const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-  if (!args.has("quiet")) std::cerr << graph::format_stats_table(result.stats);
-
-  std::vector<fs::path> files = reconstruct_outputs_in(out);
-  std::erase_if(files, [](const fs::path& f) { return f.filename() == "summary.json"; });
-  const WrittenOutputs written = classify_outputs(files);
-  const bool wrote_output = !files.empty();
-  const bool earlier_put_back = earlier.count() > 0 && !wrote_output;
-  if (const std::string note = earlier.settle(wrote_output); !note.empty())
-    std::cerr << "mocap reconstruct: " << note << "\n";
-  const std::string outcome = !result.ok       ? "failed: " + result.error
-                              : result.stopped ? std::string("interrupted")
-                                               : std::string();
-  if (earlier_put_back || (!wrote_output && !outcome.empty())) {
-    if (!outcome.empty()) std::cerr << "mocap reconstruct: " << outcome << "\n";
-    std::cerr << "mocap reconstruct: nothing was written into " << out.string() << "\n";
-    return !result.ok ? 1 : result.stopped ? 130 : 0;
-  }
+  const ReconstructRun run = run_reconstruct_graph(resolved, options, progress, bar, earlier, out,
+                                                   args.has("quiet"), started);
+  if (run.nothing_written) return *run.nothing_written;
+  const graph::RunResult& result = run.result;
+  const double seconds = run.seconds;
+  const std::vector<fs::path>& files = run.files;
+  const WrittenOutputs& written = run.written;
+  const std::string& outcome = run.outcome;
   json summary = summarize_output(out / "poses.jsonl");
   summary["calibration"] = rig_file;
   json view_list = json::array();

@@ -2,7 +2,9 @@
 // What the monocular and the multi-view `mocap reconstruct` share (reconstruct_command.cpp): the
 // checks before a graph runs and the report of what it wrote.
 
+#include <chrono>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -10,6 +12,8 @@
 
 #include "graph/graph_spec.hpp"
 #include "graph/stats.hpp"
+#include "graph_runner.hpp"
+#include "progress_bar.hpp"
 #include "reconstruct_outputs.hpp"
 
 namespace mocap::cli {
@@ -28,6 +32,25 @@ void print_written(const std::filesystem::path& out, const WrittenOutputs& writt
 // For a run that did not complete but wrote something: what it kept, and what it did not write.
 std::string incomplete_note(const WrittenOutputs& written, const nlohmann::json& summary,
                             std::int64_t input_frames);
+// A reconstruct graph run into `out` and what it left there. Every output file in `out` is then
+// this run's (earlier ones were refused or set aside by `earlier`, settled here); the statistics
+// table is printed unless `quiet`.
+struct ReconstructRun {
+  graph::RunResult result;
+  double seconds = 0.0;                      // from `started` to the end of the run
+  std::vector<std::filesystem::path> files;  // this run's outputs, summary.json aside
+  WrittenOutputs written;
+  std::string outcome;  // "failed: ERROR", "interrupted", or empty for a run that completed
+  // Set when the run wrote nothing (its messages are printed): the exit code. The folder stays
+  // as it was, an earlier output back with its summary.json, so no summary is written.
+  std::optional<int> nothing_written;
+};
+ReconstructRun run_reconstruct_graph(const graph::ResolvedGraph& graph,
+                                     const graph::RunOptions& options,
+                                     const ProgressCallback& progress, ProgressBar& bar,
+                                     EarlierOutput& earlier, const std::filesystem::path& out,
+                                     bool quiet, std::chrono::steady_clock::time_point started);
+
 // Per node: in, out, drops, latency.
 nlohmann::json node_latency(const graph::GraphStats& stats);
 
