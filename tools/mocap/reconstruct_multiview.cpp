@@ -363,11 +363,6 @@ int reconstruct_multiview_command(int argc, char** argv) {
   const ReconstructRun run = run_reconstruct_graph(resolved, options, progress, bar, earlier, out,
                                                    args.has("quiet"), started);
   if (run.nothing_written) return *run.nothing_written;
-  const graph::RunResult& result = run.result;
-  const double seconds = run.seconds;
-  const std::vector<fs::path>& files = run.files;
-  const WrittenOutputs& written = run.written;
-  const std::string& outcome = run.outcome;
   json summary = summarize_output(out / "poses.jsonl");
   summary["calibration"] = rig_file;
   json view_list = json::array();
@@ -381,26 +376,7 @@ int reconstruct_multiview_command(int argc, char** argv) {
   summary["views"] = view_list;
   summary["fps"] = fps;
   summary["floor"] = floor_how;
-  summary["seconds"] = seconds;
-  const double frames_per_second = seconds > 0 ? summary["frames"].get<double>() / seconds : 0.0;
-  summary["frames_per_second"] = frames_per_second;
-  summary["nodes"] = node_latency(result.stats);
-  summary["completed"] = result.ok && !result.stopped;
-  summary["interrupted"] = result.stopped;
-  if (!result.ok) summary["error"] = result.error;
-  summary["files"] = files_json(files);
-  summary["git_commit"] = git_commit();
-  const fs::path summary_file = out / "summary.json";
-  write_file_atomically(summary_file, json_text(summary, 2) + "\n");
-
-  print_written(out, written, summary, frames_per_second);
-  std::cout << "wrote " << summary_file.string() << "\n";
-  if (!outcome.empty()) {
-    std::cerr << "mocap reconstruct: " << outcome << "\n"
-              << "mocap reconstruct: " << incomplete_note(written, summary, frames) << "\n";
-  }
-  if (!result.ok) return 1;
-  return result.stopped ? 130 : 0;
+  return finish_reconstruct(run, summary, out, frames);
 }
 
 }  // namespace mocap::cli
