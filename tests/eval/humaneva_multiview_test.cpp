@@ -1,7 +1,8 @@
 #include "eval/humaneva_multiview.hpp"
 
+#include "eval/multiview_protocol.hpp"
+
 #include <memory>
-#include <numeric>
 
 #include <gtest/gtest.h>
 
@@ -64,17 +65,19 @@ class HumanEvaMultiviewShared : public ::testing::Test {
     MOCAP_REQUIRE_SHARED(std::string(kFolder) + "/" + std::string(he::kPositions2dFile));
   }
 
-  // Mean absolute joint error (mm, world, no alignment) of the triangulation from `cameras` at
-  // σ 0, and its coverage.
-  static std::pair<double, double> error_mm(const std::vector<int>& cameras) {
-    const HumanEvaTake& take = takes_->front();
+  static TakeReconstruction reconstruct(const std::vector<int>& cameras, bool fit) {
     const std::vector<recon::BodyXyc> inputs[] = {(*sequences_)[0].input, (*sequences_)[1].input,
                                                   (*sequences_)[2].input};
     HumanEvaMultiviewOptions options;
-    options.fit = false;
-    const TakeReconstruction r = reconstruct_take(take, *sequences_, inputs, cameras, options);
+    options.fit = fit;
+    return reconstruct_take(takes_->front(), *sequences_, inputs, cameras, options);
+  }
+  // Mean absolute joint error (mm, world, no alignment) of the triangulation from `cameras` at
+  // σ 0, and its coverage.
+  static std::pair<double, double> error_mm(const std::vector<int>& cameras) {
+    const TakeReconstruction r = reconstruct(cameras, false);
     EXPECT_EQ(r.extra_people, 0);
-    const TakeScores s = score_take(r.triangulated, take.truth_world, nullptr, true);
+    const TakeScores s = score_take(r.triangulated, takes_->front().truth_world, nullptr, true);
     return {1000.0 * s.absolute_m / static_cast<double>(s.absolute_frames), s.pose.coverage()};
   }
 
@@ -84,6 +87,7 @@ class HumanEvaMultiviewShared : public ::testing::Test {
 
 TEST_F(HumanEvaMultiviewShared, TakesAreChunksSeenByTheThreeCamerasInTheWorld) {
   ASSERT_EQ(takes_->size(), 1u);
+  EXPECT_EQ(sequences_->front().subject + " " + sequences_->front().chunk, "S1 Walking 1 chunk2");
   const HumanEvaTake& take = takes_->front();
   ASSERT_EQ(take.truth_world.size(), kFrames);
   // HumanEva's world is Z up with the floor at Z = 0: the head is well above the ankles.
@@ -100,14 +104,26 @@ TEST_F(HumanEvaMultiviewShared, ThreeCamerasReconstructTheTruthAndTwoDoNoBetter)
   EXPECT_LT(three, 10.0);
   // Every frame but a track's first ones (TrackingOptions::min_hits) is reported.
   EXPECT_GE(coverage, (kFrames - 2.0) / kFrames);
-  // Measured (S1 Jog): 8.5 mm with all three; C1+C2 9.5, C1+C3 9.2, C2+C3 15.9 (C2 and C3
-  // face each other, 176 degrees apart: depth along their common axis is poorly seen).
+  // Measured (S1 "Walking 1 chunk2"): 8.5 mm with all three; C1+C2 9.5, C1+C3 9.2, C2+C3 15.9 (C2
+  // and C3 face each other, 176 degrees apart: depth along their common axis is poorly seen).
   for (const auto& pair : {std::vector<int>{0, 1}, {0, 2}, {1, 2}}) {
     const auto [two, pair_coverage] = error_mm(pair);
     EXPECT_GE(two, three) << cameras_label(pair);
     EXPECT_LT(two, 25.0) << cameras_label(pair);
     EXPECT_GE(pair_coverage, (kFrames - 2.0) / kFrames) << cameras_label(pair);
   }
+}
+
+TEST_F(HumanEvaMultiviewShared, TheFitKeepsOneSkeletonNearTheTruth) {
+  const TakeReconstruction r = reconstruct({0, 1, 2}, true);
+  ASSERT_EQ(r.fitted.size(), kFrames);
+  TakeScores s = score_take(r.fitted, takes_->front().truth_world, nullptr, true);
+  ASSERT_GT(s.absolute_frames, 0);
+  EXPECT_LT(1000.0 * s.absolute_m / static_cast<double>(s.absolute_frames), 25.0);
+  MultiviewResult bones;
+  add_track_metrics(s.tracks, bones);
+  EXPECT_LT(bones.bone_std_mm, 0.1);  // one set of bone lengths for the whole take
+  EXPECT_GT(bones.truth_bone_std_mm, bones.bone_std_mm);
 }
 
 }  // namespace

@@ -137,6 +137,160 @@ constexpr const char* kNote =
     "triangulate them; the monocular rows retrieve CMU's canonical joints (mid-hip, neck, head "
     "top), so part of their error is that difference of definitions";
 
+// What every job reads.
+struct Evaluation {
+  const posedb::Database* db = nullptr;
+  const Config* config = nullptr;  // the monocular protocol's
+  const recon::FrameBones* bones = nullptr;
+  const fit::ContactDetector* contacts = nullptr;
+  fit::FitOptions mono_fit;
+  eval::HumanEvaMultiviewOptions multiview;
+  bool fit = true;
+  std::vector<eval::HumanEvaSequence> sequences;
+  std::vector<eval::HumanEvaTake> takes;
+  std::vector<eval::Condition> conditions;
+  std::vector<Row> rows;
+  std::vector<std::vector<int>> sets;  // the several-camera sets, in row order
+
+  std::size_t row(const std::vector<int>& cameras, bool fitted) const {
+    for (std::size_t i = 0; i < rows.size(); ++i)
+      if (rows[i].cameras == cameras && rows[i].fitted == fitted) return i;
+    throw std::logic_error("no row " + eval::cameras_label(cameras));
+  }
+  // Camera c's 2D of a take with the monocular protocol's noise and seed (mocap eval humaneva).
+  std::vector<recon::BodyXyc> input(const Job& job, int c) const {
+    const std::size_t s = takes[job.take].sequence[static_cast<std::size_t>(c)];
+    return eval::noisy_input(sequences[s], conditions[job.condition],
+                             1000003ull * s + job.condition);
+  }
+};
+
+using Poses = std::vector<std::vector<std::vector<std::vector<recon::Pose3D>>>>;  // [n][take][row]
+// Per condition and camera set: people reported besides the subject, frames missing a joint.
+struct Counts {
+  std::vector<std::vector<long>> extra_people, partial_frames;
+};
+
+// The monocular job: the protocol's retrieval and the monocular fit of one camera.
+void run_monocular(const Evaluation& e, const Job& job,
+                   std::vector<std::vector<recon::Pose3D>>& out) {
+  const eval::HumanEvaSequence& s =
+      e.sequences[e.takes[job.take].sequence[static_cast<std::size_t>(job.camera)]];
+  recon::Matcher matcher(*e.db, e.config->match);
+  recon::SequenceOptions retrieval = e.config->sequence;
+  retrieval.camera = s.camera;  // the configuration turns poses onto the root's ray
+  fit::FitOptions options = e.mono_fit;
+  options.camera = s.camera;
+  const fit::ViewFits fits = fit::reconstruct_and_fit(
+      matcher, *e.bones, e.contacts, e.input(job, job.camera), retrieval, options, {e.fit, false});
+  out[e.row({job.camera}, false)] = fits.retrieved;
+  if (e.fit) out[e.row({job.camera}, true)] = placed_poses(fits.full);
+}
+
+Poses run_jobs(const Evaluation& e, int threads, Counts& counts) {
+  std::vector<Job> jobs;
+  for (std::size_t n = 0; n < e.conditions.size(); ++n)
+    for (std::size_t t = 0; t < e.takes.size(); ++t) {
+      for (int c = 0; c < he::kCameras; ++c) jobs.push_back({n, t, c, 0});
+      for (std::size_t s = 0; s < e.sets.size(); ++s) jobs.push_back({n, t, -1, s});
+    }
+  Poses poses(e.conditions.size(),
+              std::vector<std::vector<std::vector<recon::Pose3D>>>(
+                  e.takes.size(), std::vector<std::vector<recon::Pose3D>>(e.rows.size())));
+  counts.extra_people.assign(e.conditions.size(), std::vector<long>(e.sets.size(), 0));
+  counts.partial_frames = counts.extra_people;
+  std::mutex counts_mutex;
+  ProgressBar bar;
+  posedb::for_each_chunk(
+      jobs.size(), threads,
+      [&](std::size_t i) {
+        const Job& job = jobs[i];
+        auto& out = poses[job.condition][job.take];  // each job writes its own rows
+        if (job.camera >= 0) return run_monocular(e, job, out);
+        const std::vector<recon::BodyXyc> inputs[] = {e.input(job, 0), e.input(job, 1),
+                                                      e.input(job, 2)};
+        const auto& set = e.sets[job.set];
+        const auto r =
+            eval::reconstruct_take(e.takes[job.take], e.sequences, inputs, set, e.multiview);
+        out[e.row(set, false)] = r.triangulated;
+        if (e.fit) out[e.row(set, true)] = r.fitted;
+        const std::lock_guard lock(counts_mutex);
+        counts.extra_people[job.condition][job.set] += r.extra_people;
+        counts.partial_frames[job.condition][job.set] += r.partial_frames;
+      },
+      [&](std::size_t done) {
+        bar.update("evaluate", static_cast<double>(done) / static_cast<double>(jobs.size()));
+      });
+  bar.finish();
+  return poses;
+}
+
+// Every row's scores at one noise level, each take scored on the frames all rows reconstructed.
+std::vector<Totals> score_rows(const Evaluation& e, const Poses& poses, std::size_t condition) {
+  std::vector<Totals> totals(e.rows.size());
+  for (std::size_t t = 0; t < e.takes.size(); ++t) {
+    const eval::HumanEvaTake& take = e.takes[t];
+    const auto& take_poses = poses[condition][t];
+    std::vector<char> keep(take.truth_world.size(), 1);
+    for (const auto& p : take_poses)
+      for (std::size_t f = 0; f < keep.size(); ++f) keep[f] = keep[f] && p[f].valid;
+    const std::string& action = e.sequences[take.sequence[0]].action;
+    for (std::size_t r = 0; r < e.rows.size(); ++r) {
+      const Row& row = e.rows[r];
+      const bool mono = row.cameras.size() == 1;
+      const auto& truth =
+          mono ? e.sequences[take.sequence[static_cast<std::size_t>(row.cameras[0])]].truth_camera
+               : take.truth_world;
+      const eval::TakeScores s = eval::score_take(take_poses[r], truth, &keep, !mono || row.fitted);
+      totals[r].all.add(s);
+      totals[r].per_action[action].add(s);
+      totals[r].frames += static_cast<double>(keep.size());
+      for (const auto& p : take_poses[r]) totals[r].own_valid += p.valid ? 1.0 : 0.0;
+    }
+  }
+  return totals;
+}
+
+// The rows of one camera (count 1) or of one pair (count 2) at a stage, added up.
+Totals pooled(const Evaluation& e, const std::vector<Totals>& totals, bool fitted,
+              std::size_t count) {
+  Totals sum;
+  for (std::size_t r = 0; r < e.rows.size(); ++r) {
+    if (e.rows[r].fitted != fitted || e.rows[r].cameras.size() != count) continue;
+    sum.all.add(totals[r].all);
+    for (const auto& [a, s] : totals[r].per_action) sum.per_action[a].add(s);
+    sum.frames += totals[r].frames;
+    sum.own_valid += totals[r].own_valid;
+  }
+  return sum;
+}
+
+// One noise level's table, each camera's and each pair's rows followed by their pool.
+json print_table(const Evaluation& e, const std::vector<Totals>& totals, const std::string& label) {
+  std::cout << "\n### " << label
+            << "\n\n| cameras | method | frames | coverage | MPJPE mm | PA-MPJPE mm | MPJPE abs "
+               "mm | accel mm/f² | bone std mm | PA Walk | PA Jog | PA Box |\n"
+               "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+  json per_row = json::object();
+  for (std::size_t r = 0; r < e.rows.size(); ++r) {
+    const Row& row = e.rows[r];
+    print_row(row.input(), row.method(), totals[r]);
+    per_row[row.input() + ", " + row.method()] = totals_json(totals[r]);
+    const bool last_single = row.cameras == std::vector<int>{2};
+    const bool last_pair = row.cameras == std::vector<int>{1, 2};
+    if (!(last_single || last_pair) || (e.fit && !row.fitted)) continue;
+    for (const bool fitted : {false, true}) {
+      if (fitted && !e.fit) continue;
+      const Totals sum = pooled(e, totals, fitted, row.cameras.size());
+      const std::string input = last_single ? "each of C1, C2, C3" : "each pair";
+      const std::string method = Row{row.cameras, fitted}.method();
+      print_row("**" + input + "**", method, sum);
+      per_row[input + ", " + method] = totals_json(sum);
+    }
+  }
+  return per_row;
+}
+
 // Comma-separated percentages.
 Range noise_percentages() {
   Range range = Range::between(0.0, 100.0);
@@ -190,7 +344,6 @@ int humaneva_multiview_command(int argc, char** argv) {
         s.input.resize(static_cast<std::size_t>(max));
         s.truth_camera.resize(static_cast<std::size_t>(max));
       }
-  const auto takes = eval::humaneva_takes(sequences, cameras);
   std::vector<eval::Condition> conditions;
   for (const double percent : args.numbers("noise"))
     conditions.push_back({static_cast<float>(percent / 100.0), 0.0f});
@@ -203,149 +356,41 @@ int humaneva_multiview_command(int argc, char** argv) {
     throw std::logic_error(std::string("no monocular configuration ") + kMonocularConfig);
   const recon::FrameBones bones(db);
   const fit::ContactDetector contacts(db);
-  fit::FitOptions mono_fit;
-  mono_fit.ground = cameras.begin()->second.floor.value();  // HumanEva's world Z = 0
-  eval::HumanEvaMultiviewOptions multiview;
-  multiview.fps = fps;
-  multiview.fit = fit;
-
-  const std::vector<Row> rows = make_rows(fit);
-  std::vector<std::vector<int>> sets;  // the multi-view camera sets, in row order
-  for (const Row& r : rows)
-    if (r.cameras.size() > 1 && !r.fitted) sets.push_back(r.cameras);
-  const auto row_of = [&](const std::vector<int>& set, bool fitted) {
-    for (std::size_t i = 0; i < rows.size(); ++i)
-      if (rows[i].cameras == set && rows[i].fitted == fitted) return i;
-    throw std::logic_error("no such row");
-  };
-
-  std::vector<Job> jobs;
-  for (std::size_t n = 0; n < conditions.size(); ++n)
-    for (std::size_t t = 0; t < takes.size(); ++t) {
-      for (int c = 0; c < he::kCameras; ++c) jobs.push_back({n, t, c, 0});
-      for (std::size_t s = 0; s < sets.size(); ++s) jobs.push_back({n, t, -1, s});
-    }
-  // poses[condition][take][row]
-  std::vector<std::vector<std::vector<std::vector<recon::Pose3D>>>> poses(
-      conditions.size(), std::vector<std::vector<std::vector<recon::Pose3D>>>(
-                             takes.size(), std::vector<std::vector<recon::Pose3D>>(rows.size())));
-  // Per condition and camera set: people reported besides the subject, frames missing a joint.
-  std::vector<std::vector<long>> extra_people(conditions.size(), std::vector<long>(sets.size())),
-      partial_frames = extra_people;
-  std::mutex counts_mutex;
-  ProgressBar bar;
-  posedb::for_each_chunk(
-      jobs.size(), threads,
-      [&](std::size_t i) {
-        const Job& job = jobs[i];
-        const eval::HumanEvaTake& take = takes[job.take];
-        // Every camera's 2D with the monocular protocol's noise and seed (mocap eval humaneva).
-        const auto input = [&](int c) {
-          const std::size_t s = take.sequence[static_cast<std::size_t>(c)];
-          return eval::noisy_input(sequences[s], conditions[job.condition],
-                                   1000003ull * s + job.condition);
-        };
-        auto& out = poses[job.condition][job.take];
-        if (job.camera >= 0) {
-          const eval::HumanEvaSequence& s =
-              sequences[take.sequence[static_cast<std::size_t>(job.camera)]];
-          recon::Matcher matcher(db, config->match);
-          recon::SequenceOptions retrieval = config->sequence;
-          retrieval.camera = s.camera;  // the configuration turns poses onto the root's ray
-          fit::FitOptions options = mono_fit;
-          options.camera = s.camera;
-          const fit::ViewFits fits = fit::reconstruct_and_fit(
-              matcher, bones, &contacts, input(job.camera), retrieval, options, {fit, false});
-          out[row_of({job.camera}, false)] = fits.retrieved;
-          if (fit) out[row_of({job.camera}, true)] = placed_poses(fits.full);
-          return;
-        }
-        const std::vector<recon::BodyXyc> inputs[] = {input(0), input(1), input(2)};
-        const auto r = eval::reconstruct_take(take, sequences, inputs, sets[job.set], multiview);
-        out[row_of(sets[job.set], false)] = r.triangulated;
-        if (fit) out[row_of(sets[job.set], true)] = r.fitted;
-        const std::lock_guard lock(counts_mutex);
-        extra_people[job.condition][job.set] += r.extra_people;
-        partial_frames[job.condition][job.set] += r.partial_frames;
-      },
-      [&](std::size_t done) {
-        bar.update("evaluate", static_cast<double>(done) / static_cast<double>(jobs.size()));
-      });
-  bar.finish();
+  Evaluation e;
+  e.db = &db;
+  e.config = &*config;
+  e.bones = &bones;
+  e.contacts = &contacts;
+  e.mono_fit.ground = cameras.begin()->second.floor.value();  // HumanEva's world Z = 0
+  e.multiview.fps = fps;
+  e.multiview.fit = fit;
+  e.fit = fit;
+  e.sequences = std::move(sequences);
+  e.takes = eval::humaneva_takes(e.sequences, cameras);
+  e.conditions = std::move(conditions);
+  e.rows = make_rows(fit);
+  for (const Row& r : e.rows)
+    if (r.cameras.size() > 1 && !r.fitted) e.sets.push_back(r.cameras);
+  Counts counts;
+  const Poses poses = run_jobs(e, threads, counts);
 
   std::size_t frames = 0;
-  for (const auto& take : takes) frames += take.truth_world.size();
+  for (const auto& take : e.takes) frames += take.truth_world.size();
   std::cout << leaks.markdown_warning() << "## HumanEva-I Validate, several cameras and one\n\n"
-            << takes.size() << " chunks (Walk, Jog, Box; S1-S3), " << frames << " frames at " << fps
-            << " fps; monocular rows: " << args.get("db") << ", configuration \""
+            << e.takes.size() << " chunks (Walk, Jog, Box; S1-S3), " << frames << " frames at "
+            << fps << " fps; monocular rows: " << args.get("db") << ", configuration \""
             << kMonocularConfig << "\"; several cameras: components/multiview defaults"
             << (fit ? ", multi-view fit full mode (multiview_fit_defaults)" : "") << "\n";
   json results = json::object();
-  for (std::size_t n = 0; n < conditions.size(); ++n) {
-    std::vector<Totals> totals(rows.size());
-    for (std::size_t t = 0; t < takes.size(); ++t) {
-      const auto& take = takes[t];
-      const auto& take_poses = poses[n][t];
-      std::vector<char> keep(take.truth_world.size(), 1);
-      for (const auto& p : take_poses)
-        for (std::size_t f = 0; f < keep.size(); ++f) keep[f] = keep[f] && p[f].valid;
-      const std::string& action = sequences[take.sequence[0]].action;
-      for (std::size_t r = 0; r < rows.size(); ++r) {
-        const bool mono = rows[r].cameras.size() == 1;
-        const auto& truth =
-            mono ? sequences[take.sequence[static_cast<std::size_t>(rows[r].cameras[0])]]
-                       .truth_camera
-                 : take.truth_world;
-        const eval::TakeScores s =
-            eval::score_take(take_poses[r], truth, &keep, !mono || rows[r].fitted);
-        totals[r].all.add(s);
-        totals[r].per_action[action].add(s);
-        totals[r].frames += static_cast<double>(keep.size());
-        for (const auto& p : take_poses[r]) totals[r].own_valid += p.valid ? 1.0 : 0.0;
-      }
-    }
-    std::cout << "\n### " << conditions[n].label()
-              << "\n\n| cameras | method | frames | coverage | MPJPE mm | PA-MPJPE mm | MPJPE abs "
-                 "mm | accel mm/f² | bone std mm | PA Walk | PA Jog | PA Box |\n"
-                 "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
-    json per_row = json::object();
-    const auto pooled = [&](bool fitted, std::size_t count) {
-      Totals sum;
-      for (std::size_t r = 0; r < rows.size(); ++r) {
-        const bool in = rows[r].fitted == fitted &&
-                        (count == 1 ? rows[r].cameras.size() == 1 : rows[r].cameras.size() == 2);
-        if (!in) continue;
-        sum.all.add(totals[r].all);
-        for (const auto& [a, s] : totals[r].per_action) sum.per_action[a].add(s);
-        sum.frames += totals[r].frames;
-        sum.own_valid += totals[r].own_valid;
-      }
-      return sum;
-    };
-    for (std::size_t r = 0; r < rows.size(); ++r) {
-      print_row(rows[r].input(), rows[r].method(), totals[r]);
-      per_row[rows[r].input() + ", " + rows[r].method()] = totals_json(totals[r]);
-      // After each camera's (each pair's) last row, the pooled row.
-      const bool last_single = rows[r].cameras == std::vector<int>{2};
-      const bool last_pair = rows[r].cameras == std::vector<int>{1, 2};
-      if ((last_single || last_pair) && (rows[r].fitted || !fit)) {
-        for (const bool fitted : {false, true}) {
-          if (fitted && !fit) continue;
-          const Totals sum = pooled(fitted, last_single ? 1 : 2);
-          const std::string input = last_single ? "each of C1, C2, C3" : "each pair";
-          const Row kind{last_single ? std::vector<int>{0} : std::vector<int>{0, 1}, fitted};
-          print_row("**" + input + "**", kind.method(), sum);
-          per_row[input + ", " + kind.method()] = totals_json(sum);
-        }
-      }
-    }
-    results[conditions[n].label()] = per_row;
-  }
-  json counts = json::object();
-  for (std::size_t n = 0; n < conditions.size(); ++n)
-    for (std::size_t s = 0; s < sets.size(); ++s)
-      counts[conditions[n].label()][eval::cameras_label(sets[s])] = {
-          {"extra_people", extra_people[n][s]}, {"partial_frames", partial_frames[n][s]}};
+  for (std::size_t n = 0; n < e.conditions.size(); ++n)
+    results[e.conditions[n].label()] =
+        print_table(e, score_rows(e, poses, n), e.conditions[n].label());
+  json counts_json = json::object();
+  for (std::size_t n = 0; n < e.conditions.size(); ++n)
+    for (std::size_t s = 0; s < e.sets.size(); ++s)
+      counts_json[e.conditions[n].label()][eval::cameras_label(e.sets[s])] = {
+          {"extra_people", counts.extra_people[n][s]},
+          {"partial_frames", counts.partial_frames[n][s]}};
   std::cout << "\n" << kNote << ".\n";
   json out = {{"protocol", "humaneva-multiview"},
               {"command", command_line("mocap eval humaneva-multiview", argc, argv)},
@@ -354,10 +399,10 @@ int humaneva_multiview_command(int argc, char** argv) {
               {"database", args.get("db")},
               {"monocular_configuration", kMonocularConfig},
               {"evaluation_fps", fps},
-              {"chunks", takes.size()},
+              {"chunks", e.takes.size()},
               {"frames", frames},
               {"note", kNote},
-              {"multiview_counts", counts},
+              {"multiview_counts", counts_json},
               {"joint_correspondence", eval::humaneva_joint_correspondence()},
               {"leak", leaks.to_json()},
               {"results", results}};
