@@ -336,11 +336,9 @@ std::string pose2sim_table(const Pose2SimComparison& c) {
   for (const Pose2SimRun& r : c.runs)
     s << r.name << " " << r.frames_with_participant << " (other people reported " << r.other_people
       << "); ";
-  s << "\n\nWith skeleton fitting: the fitted 15 body joints, compared on the markers that are "
-       "body "
-       "joints in BODY_25B's mapping (all 14 here: Neck is UpperNeck, Head HeadTop); \"views "
-       "used\" counts the person's views, the fit uses every one of them.\n";
-  \"views used\" counts the views of the person, the fit uses every one of them.\n";
+  s << "\n\nWith skeleton fitting: the fitted 15 body joints, compared on the markers that "
+       "are body joints in BODY_25B's mapping (all 14 here: Neck is UpperNeck, Head HeadTop); "
+       "\"views used\" counts the person's views, the fit uses every one of them.\n";
   return s.str();
 }
 

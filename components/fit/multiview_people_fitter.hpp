@@ -18,8 +18,8 @@
 //   full: window.frames frames (a person missing longer than `max_missed` frames ends their
 //         track, which is solved then).
 // A track ends when its person has been missing for more than `max_missed` frames; the same id
-// seen later starts a new track (new bone lengths). A person whose frame the fit could not place
-// (not triangulated at all) keeps the triangulated joints.
+// seen later starts a new track (new bone lengths). A person whose root (mid-hip) is not
+// triangulated in a frame is not fitted there and keeps the triangulated joints.
 //
 // A stop (stop()): full mode solves no window any more; finish() solves each track's held frames
 // once with `stop_iterations`, so that an interrupted run still writes every frame.

@@ -108,13 +108,14 @@ TEST_F(ReconstructMultiView, Pose2SimDemoAgreesWithItsTrcAndTheBvhStandsOnTheFlo
   std::vector<std::string> a = args("demo", views_);
   a.insert(a.end(), {"--fit", "full"});
   ASSERT_EQ(run("demo", a, err), 0) << err;
-  // "full fit: N of M person-frames fitted": every person-frame (all triangulated).
+  // "full fit: N of M person-frames fitted": the participant's every frame (the operator, whom
+  // cam01 and cam02 see, has frames without a triangulated root: those keep the triangulation).
   const auto status = err.find("full fit: ");
   ASSERT_NE(status, std::string::npos) << err;
   int fitted = 0, people = 0;
   ASSERT_EQ(std::sscanf(err.c_str() + status, "full fit: %d of %d", &fitted, &people), 2) << err;
-  EXPECT_GE(fitted, kFrames - 2);
-  EXPECT_EQ(fitted, people) << err;
+  EXPECT_GE(fitted, kFrames - 2) << err;
+  EXPECT_LE(fitted, people) << err;
   EXPECT_EQ(json::parse(read_file(dir_.file("demo") + "/summary.json"))["fit"], "full");
   const io::TrcFile trc =
       io::read_trc(shared_data() / kTrial / "pose-3d" / "S00_P00_T01_BalancingTrial_0-100.trc");
@@ -155,7 +156,8 @@ TEST_F(ReconstructMultiView, Pose2SimDemoAgreesWithItsTrcAndTheBvhStandsOnTheFlo
   // docs/multiview.md: 19.7 mm median over the 100 frames (our views and weights differ from
   // Pose2Sim's 15 px rule); a wrong axis, lens or camera order gives decimetres.
   EXPECT_LT(median, 0.05f);
-  // Fitted: one skeleton, every bone the same length in every frame.
+  // Fitted: one skeleton, every bone the same length in every frame (joints_world has 1 mm
+  // steps: lengths vary by 2 mm at most; the triangulation's by centimetres).
   for (const auto& [bone, joint] : kLimbJoints) {
     const std::string parent(kJointNames[kJointParent[index(*joint_from_name(joint))]]);
     float shortest = 1e9f, longest = 0.0f;
@@ -163,7 +165,7 @@ TEST_F(ReconstructMultiView, Pose2SimDemoAgreesWithItsTrcAndTheBvhStandsOnTheFlo
       const float l = glm::distance(vec(w[joint]), vec(w[parent]));
       shortest = std::min(shortest, l), longest = std::max(longest, l);
     }
-    EXPECT_LT(longest - shortest, 1e-4f) << joint;
+    EXPECT_LT(longest - shortest, 0.003f) << joint;
   }
 
   // The participant's BVH: y up, the floor (Pose2Sim's z = 0) at y = 0, the root where
