@@ -1,6 +1,7 @@
 #include "fit/multiview_people_fitter.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <map>
 #include <optional>
 
@@ -32,23 +33,30 @@ class WindowedTrack {
     inputs_.push_back(in);
     if (!solve || inputs_.size() < static_cast<std::size_t>(window_.frames)) return {};
     return solve_and_emit(inputs_.size() - static_cast<std::size_t>(window_.overlap),
-                          options_.fit.max_iterations);
+                          options_.fit.max_iterations, 0.0);
   }
 
-  std::vector<FittedFrame> finish(int iterations) {
-    return solve_and_emit(inputs_.size(), iterations);
+  // Every held frame; with a budget (a stop), one quick solve, none when its time is out.
+  std::vector<FittedFrame> finish(std::optional<SolveBudget> budget) {
+    if (!budget) return solve_and_emit(inputs_.size(), options_.fit.max_iterations, 0.0);
+    if (budget->seconds <= 0.0 || budget->iterations <= 0) {
+      std::vector<FittedFrame> unsolved(inputs_.size());
+      inputs_.clear();
+      return unsolved;
+    }
+    return solve_and_emit(inputs_.size(), budget->iterations, budget->seconds);
   }
 
   const FitStats& stats() const { return stats_; }
 
  private:
   // Solves the held frames, returns the first `emit` of them and forgets those.
-  std::vector<FittedFrame> solve_and_emit(std::size_t emit, int iterations) {
+  std::vector<FittedFrame> solve_and_emit(std::size_t emit, int iterations, double seconds) {
     if (inputs_.empty()) return {};
     MultiViewFitOptions o = options_;
     o.fit.max_iterations = iterations;
     if (bones_) o.fit.bones = *bones_, o.fit.solve_bones = false;
-    FitResult result = fit_multiview_sequence(inputs_, o);
+    FitResult result = fit_multiview_sequence(inputs_, o, seconds);
     add(stats_, result.stats);
     const bool any = std::any_of(result.frames.begin(), result.frames.end(),
                                  [](const FittedFrame& f) { return f.valid; });
@@ -113,14 +121,12 @@ struct MultiViewPeopleFitter::State {
       place_all(id, track, track.windowed->push(in, !stopping));
   }
 
-  void finish(int id, Track& track) {
+  void finish(int id, Track& track, std::optional<SolveBudget> budget) {
     if (track.live) {
       place_all(id, track, track.live->finish());
       add(stats, track.live->stats());
     } else {
-      place_all(id, track,
-                track.windowed->finish(stopping ? options.stop_iterations
-                                                : options.fit.fit.max_iterations));
+      place_all(id, track, track.windowed->finish(budget));
       add(stats, track.windowed->stats());
     }
   }
@@ -169,7 +175,7 @@ struct MultiViewPeopleFitter::State {
       Track& track = it->second;
       if (track.next_frame <= t) push(it->first, track, empty_input());  // absent this frame
       if (t - track.last_seen > options.max_missed) {
-        finish(it->first, track);
+        finish(it->first, track, std::nullopt);
         it = tracks.erase(it);
       } else {
         ++it;
@@ -205,9 +211,23 @@ std::vector<People3D> MultiViewPeopleFitter::push(People3D frame) {
 void MultiViewPeopleFitter::stop() { state_->stopping = true; }
 
 std::vector<People3D> MultiViewPeopleFitter::finish() {
+  using Clock = std::chrono::steady_clock;
   State& s = *state_;
   std::vector<People3D> out;
-  for (auto& [id, track] : s.tracks) s.finish(id, track);
+  // After a stop, the tracks share the budget's time: each gets an equal part of what is left;
+  // once too little is left for a solve, the rest leave with their triangulated joints.
+  const auto start = Clock::now();
+  std::size_t left = s.tracks.size();
+  for (auto& [id, track] : s.tracks) {
+    std::optional<SolveBudget> budget;
+    if (s.stopping) {
+      const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
+      const double share = (s.options.stop_budget.seconds - elapsed) / static_cast<double>(left);
+      budget = SolveBudget{s.options.stop_budget.iterations, share >= 0.005 ? share : 0.0};
+    }
+    s.finish(id, track, budget);
+    --left;
+  }
   s.tracks.clear();
   s.held.release_all([&](People3D&& frame) { out.push_back(std::move(frame)); });
   return out;

@@ -22,7 +22,8 @@
 // triangulated in a frame is not fitted there and keeps the triangulated joints.
 //
 // A stop (stop()): full mode solves no window any more; finish() solves each track's held frames
-// once with `stop_iterations`, so that an interrupted run still writes every frame.
+// once within a shared budget (`stop_budget`, as PeopleFitter's), frames beyond it leave with
+// their triangulated joints: an interrupted run writes every frame within the graph's drain.
 
 #include <cstdint>
 #include <memory>
@@ -45,8 +46,8 @@ struct MultiViewPeopleFitOptions {
   // Full mode. 300 frames (10 s at 30 fps) bound the delay and a solve's size; 30 frames of
   // overlap smooth the join between windows (a window's first frames are its least constrained).
   WindowOptions window{300, 30};
-  int max_missed = 10;  // frames a person may be missing before their track ends
-  int stop_iterations = 5;
+  int max_missed = 10;               // frames a person may be missing before their track ends
+  SolveBudget stop_budget{5, 0.25};  // a stop's quick solve, for all tracks together
 };
 
 class MultiViewPeopleFitter {
