@@ -164,8 +164,10 @@ Accuracy accuracy(const std::vector<std::shared_ptr<const People3D>>& out,
       }
       sum += best * kBodyJoints;
       a.joints += kBodyJoints;
-      for (int j = 1; j < kBodyJoints; ++j)
-        bones[p.id][j].push_back(glm::distance(world[j], world[kJointParent[j]]));
+      for (int j = 0; j < kBodyJoints; ++j) {
+        if (kJointParent[j] >= 0)  // the root has none
+          bones[p.id][j].push_back(glm::distance(world[j], world[kJointParent[j]]));
+      }
     }
   }
   a.mean_error_m = a.joints > 0 ? sum / a.joints : 1e9;
