@@ -501,7 +501,7 @@ PeopleCalibration calibrate_rig_from_people(std::span<const Camera> given,
   result.motion = median(motions);
   if (result.motion < o.min_motion)
     throw InputError("views", "the person hardly moves (keypoints spread " +
-                                  fixed(result.motion, 3) + " body heights, at least " +
+                                  fixed(result.motion, 4) + " body heights, at least " +
                                   fixed(o.min_motion, 2) +
                                   " needed): one person standing still gives one pose, too few "
                                   "points to place the cameras; film people walking through the "

@@ -5,6 +5,7 @@
 // compares with the truth once its world is aligned with the truth's (a similarity fitted to the
 // camera centres: our world's origin, heading and scale are our own choice).
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <optional>
