@@ -7,7 +7,7 @@
 #include <sstream>
 
 #include <glm/geometric.hpp>
-#include <glm/gtc/matrix_transform.hpp>
+#include <glm/matrix.hpp>
 #include <opencv2/calib3d.hpp>
 
 #include "camera/rig_calibration.hpp"
@@ -291,37 +291,81 @@ void set_pose(Camera& c, const detail::Pose& p) {
   c.translation = {p.translation[0], p.translation[1], p.translation[2]};
 }
 
-// After a first rig: in every view and frame the detection that best agrees with the others
-// (the smallest median reprojection error against the joints triangulated from the other views'
-// choices), so that bystanders and false detections are left out.
-void choose_by_agreement(const std::vector<Camera>& cameras,
-                         std::span<const camera::BodySequence> input,
-                         std::vector<ViewSightings>& views, const PeopleCalibrationOptions& o) {
+// The detections of a view's frame with enough confident joints.
+std::vector<Sighting> confident_people(const std::vector<BodyKeypoints>& frame,
+                                       const Camera& camera, const PeopleCalibrationOptions& o) {
+  std::vector<Sighting> out;
+  for (const BodyKeypoints& body : frame)
+    if (confident_joints(body, o.min_confidence) >= o.min_joints)
+      out.push_back(sighting_of(body, camera, o.min_confidence));
+  return out;
+}
+
+// The fundamental matrix from camera a's ideal pixels to camera b's lines (glm, column-major).
+glm::dmat3 fundamental(const Camera& a, const Camera& b) {
+  const glm::dmat3 R = b.rotation * glm::transpose(a.rotation);
+  const glm::dvec3 t = b.translation - R * a.translation;
+  const glm::dmat3 tx(0, t.z, -t.y, -t.z, 0, t.x, t.y, -t.x, 0);  // columns of [t]x
+  const auto k_inverse = [](const Camera& c) {
+    return glm::inverse(glm::dmat3(c.fx, 0, 0, 0, c.fy, 0, c.cx, c.cy, 1));
+  };
+  return glm::transpose(k_inverse(b)) * tx * R * k_inverse(a);
+}
+
+// Median over the joints both see of the symmetric distance (px) of each to the other's line.
+double epipolar_distance(const Sighting& a, const Sighting& b, const glm::dmat3& F) {
+  std::vector<double> d;
+  for (std::size_t j = 0; j < kJoints; ++j) {
+    if (a.confidence[j] <= 0 || b.confidence[j] <= 0) continue;
+    const glm::dvec3 xa(a.ideal[j], 1.0), xb(b.ideal[j], 1.0);
+    const glm::dvec3 in_b = F * xa, in_a = glm::transpose(F) * xb;
+    const double e = glm::dot(xb, in_b);
+    d.push_back(0.5 * (std::abs(e) / std::hypot(in_b.x, in_b.y) +
+                       std::abs(e) / std::hypot(in_a.x, in_a.y)));
+  }
+  return d.size() < 4 ? std::numeric_limits<double>::max() : median(d);
+}
+
+// With a rig: per frame the detections of one person across the views, by epipolar consistency
+// (several people, bystanders, false detections). Each detection of each view in turn anchors a
+// group: every other view adds its detection nearest the anchor's epipolar lines, within 2 % of
+// the image width; the group with the most views (then the closest) is the frame's person.
+void associate(const std::vector<Camera>& cameras, std::span<const camera::BodySequence> input,
+               std::vector<ViewSightings>& views, const PeopleCalibrationOptions& o) {
   const std::size_t n = views.size();
-  for (std::size_t k = 0; k < n; ++k) {
-    std::vector<bool> others(n, true);
-    others[k] = false;
-    const Points points = triangulate(cameras, others, views);
-    for (std::size_t f = 0; f < views[k].size(); ++f) {
-      double best_error = std::numeric_limits<double>::max();
-      std::optional<Sighting> best;
-      for (const BodyKeypoints& body : input[k][f]) {
-        if (confident_joints(body, o.min_confidence) < o.min_joints) continue;
-        const Sighting s = sighting_of(body, cameras[k], o.min_confidence);
-        std::vector<double> errors;
-        for (std::size_t j = 0; j < kJoints; ++j)
-          if (s.confidence[j] > 0 && points[f][j])
-            errors.push_back(glm::distance(cameras[k].project(*points[f][j]), s.pixel[j]));
-        if (errors.size() < 4) continue;
-        const double e = median(errors);
-        if (e < best_error) best_error = e, best = s;
+  std::vector<std::vector<glm::dmat3>> F(n, std::vector<glm::dmat3>(n));
+  for (std::size_t a = 0; a < n; ++a)
+    for (std::size_t b = 0; b < n; ++b)
+      if (a != b) F[a][b] = fundamental(cameras[a], cameras[b]);
+  for (std::size_t f = 0; f < views.front().size(); ++f) {
+    std::vector<std::vector<Sighting>> candidates;
+    for (std::size_t k = 0; k < n; ++k)
+      candidates.push_back(confident_people(input[k][f], cameras[k], o));
+    std::vector<int> best_group;
+    int best_views = 1;
+    double best_cost = std::numeric_limits<double>::max();
+    for (std::size_t r = 0; r < n; ++r)
+      for (std::size_t d = 0; d < candidates[r].size(); ++d) {
+        std::vector<int> group(n, -1);
+        group[r] = static_cast<int>(d);
+        int count = 1;
+        double cost = 0.0;
+        for (std::size_t k = 0; k < n; ++k) {
+          if (k == r) continue;
+          double nearest = 0.02 * cameras[k].width;
+          for (std::size_t e = 0; e < candidates[k].size(); ++e)
+            if (const double dist = epipolar_distance(candidates[r][d], candidates[k][e], F[r][k]);
+                dist < nearest)
+              nearest = dist, group[k] = static_cast<int>(e);
+          if (group[k] >= 0) ++count, cost += nearest;
+        }
+        if (count > best_views || (count == best_views && count > 1 && cost < best_cost))
+          best_views = count, best_cost = cost, best_group = group;
       }
-      // Nobody agrees within a tenth of the image: nobody (the others saw someone else).
-      if (best && best_error < 0.1 * cameras[k].width)
-        views[k][f] = *best;
-      else if (best || !input[k][f].empty())
-        views[k][f] = Sighting{};
-    }
+    for (std::size_t k = 0; k < n; ++k)
+      views[k][f] = !best_group.empty() && best_group[k] >= 0
+                        ? candidates[k][static_cast<std::size_t>(best_group[k])]
+                        : Sighting{};
   }
 }
 
@@ -461,6 +505,50 @@ WorldFrame world_from_people(const std::vector<Camera>& cameras, const Points& p
   return w;
 }
 
+// A first rig: the pair (a, b) from their essential matrix, the others one by one by PnP (most
+// keypoints shared with the placed cameras first); the joints triangulated, and the median
+// reprojection error over every keypoint.
+struct Start {
+  std::vector<Camera> cameras;
+  Points points;
+  std::size_t fixed = 0;
+  double median_px = 0.0;
+};
+
+Start initialise(std::vector<Camera> cameras, std::size_t a, std::size_t b,
+                 const std::vector<ViewSightings>& views, const std::vector<std::string>& names) {
+  const std::size_t n = cameras.size();
+  place_pair(cameras, a, b, views, names);
+  std::vector<bool> placed(n, false);
+  placed[a] = placed[b] = true;
+  Points points = triangulate(cameras, placed, views);
+  for (std::size_t round = 2; round < n; ++round) {
+    std::size_t next = n;
+    int most = -1;
+    for (std::size_t k = 0; k < n; ++k) {
+      if (placed[k]) continue;
+      int shared = 0;
+      for (std::size_t m = 0; m < n; ++m)
+        if (placed[m]) shared += shared_keypoints(views[k], views[m]);
+      if (shared > most) most = shared, next = k;
+    }
+    if (!place_by_pnp(cameras[next], views[next], points))
+      throw InputError(names[next],
+                       "cannot be placed against the joints the others triangulate "
+                       "(too few keypoints agree): film people where it overlaps");
+    placed[next] = true;
+    points = triangulate(cameras, placed, views);
+  }
+  std::vector<double> errors;
+  for (std::size_t k = 0; k < n; ++k)
+    for (std::size_t f = 0; f < points.size(); ++f)
+      for (std::size_t j = 0; j < kJoints; ++j)
+        if (views[k][f].present && views[k][f].confidence[j] > 0 && points[f][j])
+          errors.push_back(glm::distance(cameras[k].project(*points[f][j]), views[k][f].pixel[j]));
+  const double m = median(errors);
+  return {std::move(cameras), std::move(points), a, std::isfinite(m) ? m : 1e300};
+}
+
 }  // namespace
 
 PeopleCalibration calibrate_rig_from_people(std::span<const Camera> given,
@@ -519,33 +607,28 @@ PeopleCalibration calibrate_rig_from_people(std::span<const Camera> given,
                                      " needed: film people where it overlaps the others");
   }
 
-  // The best-connected pair, then the others by PnP, most shared keypoints with the placed first.
-  std::size_t a = 0, b = 1;
-  int best = -1;
+  // Starts from the best-connected pairs (an essential matrix can pick the wrong one of its
+  // poses on noisy keypoints), keeping the one whose whole rig reprojects best.
+  std::vector<std::pair<int, std::pair<std::size_t, std::size_t>>> pairs;
   for (std::size_t i = 0; i < n; ++i)
     for (std::size_t j = i + 1; j < n; ++j)
-      if (const int s = shared_keypoints(views[i], views[j]); s > best) best = s, a = i, b = j;
-  place_pair(cameras, a, b, views, names);
-  std::vector<bool> placed(n, false);
-  placed[a] = placed[b] = true;
-  Points points = triangulate(cameras, placed, views);
-  for (std::size_t round = 2; round < n; ++round) {
-    std::size_t next = n;
-    int most = -1;
-    for (std::size_t k = 0; k < n; ++k) {
-      if (placed[k]) continue;
-      int shared = 0;
-      for (std::size_t m = 0; m < n; ++m)
-        if (placed[m]) shared += shared_keypoints(views[k], views[m]);
-      if (shared > most) most = shared, next = k;
+      pairs.push_back({shared_keypoints(views[i], views[j]), {i, j}});
+  std::sort(pairs.rbegin(), pairs.rend());
+  pairs.resize(std::min<std::size_t>(pairs.size(), 3));
+  std::optional<Start> start;
+  std::string failure;
+  for (const auto& [shared, pair] : pairs) {
+    try {
+      Start s = initialise(cameras, pair.first, pair.second, views, names);
+      if (!start || s.median_px < start->median_px) start = std::move(s);
+    } catch (const InputError& e) {
+      if (failure.empty()) failure = e.what();
     }
-    if (!place_by_pnp(cameras[next], views[next], points))
-      throw InputError(names[next],
-                       "cannot be placed against the joints the others triangulate "
-                       "(too few keypoints agree): film people where it overlaps");
-    placed[next] = true;
-    points = triangulate(cameras, placed, views);
   }
+  if (!start) throw InputError("views", failure);
+  cameras = start->cameras;
+  Points points = std::move(start->points);
+  const std::size_t a = start->fixed;
   // Roughly metres before the bundle (its bone weight is per metre).
   const double first_scale = stature_bones(canonical_bones()) / stature_bones(bone_medians(points));
   if (!(std::isfinite(first_scale) && first_scale > 0))
@@ -558,10 +641,12 @@ PeopleCalibration calibrate_rig_from_people(std::span<const Camera> given,
   for (std::size_t k = 0; k < n && !several; ++k)
     for (const auto& frame : input[k]) several = several || frame.size() > 1;
   if (several) {
-    choose_by_agreement(cameras, input, views, o);
+    associate(cameras, input, views, o);
     points = triangulate(cameras, std::vector<bool>(n, true), views);
     solved = adjust(cameras, points, views, a, o);
-    result.notes.push_back("several detections per frame: the person chosen by agreement");
+    result.notes.push_back(
+        "several detections per frame: one person per frame associated across the views by "
+        "epipolar consistency with the first rig");
   }
 
   // Metres from the bones.
