@@ -641,9 +641,12 @@ PeopleCalibration calibrate_rig_from_people(std::span<const Camera> given,
   for (std::size_t k = 0; k < n && !several; ++k)
     for (const auto& frame : input[k]) several = several || frame.size() > 1;
   if (several) {
-    associate(cameras, input, views, o);
-    points = triangulate(cameras, std::vector<bool>(n, true), views);
-    solved = adjust(cameras, points, views, a, o);
+    // Twice: the first rig comes from a person chosen per view, not across the views.
+    for (int round = 0; round < o.association_rounds; ++round) {
+      associate(cameras, input, views, o);
+      points = triangulate(cameras, std::vector<bool>(n, true), views);
+      solved = adjust(cameras, points, views, a, o);
+    }
     result.notes.push_back(
         "several detections per frame: one person per frame associated across the views by "
         "epipolar consistency with the first rig");

@@ -44,6 +44,7 @@ struct PeopleCalibrationOptions {
   double outlier_floor_px = 2.0;  // never drop below this error (detector keypoints are noisy)
   double loss_px = 3.0;           // Huber loss scale of the reprojection errors
   double bone_weight_px_per_m = 200.0;  // a bone 1 cm off its length costs like 2 px
+  int association_rounds = 2;  // several people: associate across the views and solve, repeated
 };
 
 struct PeopleCameraReport {

@@ -95,7 +95,8 @@ double mpjpe_mm(const std::vector<std::vector<eval::Body>>& found, const test::P
   return n ? 1000 * sum / n : std::nan("");
 }
 
-void virtual_cases(const fs::path& cmu, int frames, const std::vector<double>& noises) {
+void virtual_cases(const fs::path& cmu, int frames, const std::vector<double>& noises,
+                   bool together_only) {
   const std::vector<std::string> clips = {"02_01.bvh", "07_01.bvh", "07_05.bvh", "07_12.bvh"};
   std::vector<std::string> files;
   for (const auto& c : clips) files.push_back((cmu / c).string());
@@ -111,6 +112,7 @@ void virtual_cases(const fs::path& cmu, int frames, const std::vector<double>& n
   for (std::size_t i = 0; i <= truth.size(); ++i)
     for (double noise : noises) {
       const bool together = i == truth.size();
+      if (together_only && !together) continue;
       std::vector<eval::ScenePerson> people(together ? 3 : 1);
       for (std::size_t p = 0; p < people.size(); ++p) people[p].motion = &truth[together ? p : i];
       eval::spread_people(people, frames, 2.0f, 1.0f, 1);
@@ -162,7 +164,8 @@ int main(int argc, char** argv) {
       .option("noise", "LIST", "noise σ of the virtual 2D, fractions of the box height",
               "0.01,0.02", cli::Range::positive_list())
       .flag("skip-virtual", "only the demo")
-      .flag("skip-demo", "only the virtual scenes");
+      .flag("skip-demo", "only the virtual scenes")
+      .flag("together-only", "of the virtual scenes, only the walkers together");
   int code = 0;
   if (!args.parse(argc - 1, argv + 1, code)) return code;
   try {
@@ -171,7 +174,7 @@ int main(int argc, char** argv) {
                     args.has("aligned") ? fs::path(args.get("aligned")) : fs::path());
     if (!args.has("skip-virtual"))
       virtual_cases(args.get("cmu"), static_cast<int>(args.integer("frames")),
-                    args.numbers("noise"));
+                    args.numbers("noise"), args.has("together-only"));
   } catch (const std::exception& e) {
     std::cerr << "mocap-bench-people-rig: " << e.what() << "\n";
     return 1;

@@ -512,7 +512,9 @@ int rig_people_command(int argc, char** argv) {
               "comma-separated camera names, one per view (default: those of --intrinsics, "
               "else cam_01, cam_02, ...)")
       .option("layout", "NAME", "the JSON's 25-keypoint layout: auto, BODY_25 or BODY_25B", "auto")
-      .option("height", "M", "the person's height, metres (default: the canonical body's)",
+      .option("height", "M",
+              "the person's height, metres, as the 15-joint skeleton measures it: head top to sole "
+              "along the bones (default: the canonical body's, 1.52 m; docs/cameras.md)",
               std::nullopt, Range::between(0.5, 2.5))
       .option("outlier", "X", "drop keypoints whose error exceeds X times the median (> 1)", "3",
               outlier_range())
