@@ -50,6 +50,25 @@ Block6 block(const Pose& p) {
 
 Pose pose(const Block6& b) { return {{b[0], b[1], b[2]}, {b[3], b[4], b[5]}}; }
 
+// A world point through a camera's pose and intrinsics (OpenCV's rational model), minus the
+// pixel seen.
+template <typename T>
+void reproject(const T* k, const T* camera, const T* world, const std::array<double, 2>& pixel,
+               T* residual) {
+  T local[3];
+  ceres::AngleAxisRotatePoint(camera, world, local);
+  for (int i = 0; i < 3; ++i) local[i] += camera[3 + i];
+  const T x = local[0] / local[2], y = local[1] / local[2];
+  const T r2 = x * x + y * y, r4 = r2 * r2, r6 = r4 * r2;
+  const T radial =
+      (T(1) + k[4] * r2 + k[5] * r4 + k[8] * r6) / (T(1) + k[9] * r2 + k[10] * r4 + k[11] * r6);
+  const T xd = x * radial + T(2) * k[6] * x * y + k[7] * (r2 + T(2) * x * x);
+  const T yd = y * radial + k[6] * (r2 + T(2) * y * y) + T(2) * k[7] * x * y;
+  residual[0] = k[0] * xd + k[2] - T(pixel[0]);
+  residual[1] = k[1] * yd + k[3] - T(pixel[1]);
+}
+
+// A board corner: board frame -> world -> image.
 struct Reprojection {
   std::array<double, 3> object;
   std::array<double, 2> pixel;
@@ -57,19 +76,37 @@ struct Reprojection {
   template <typename T>
   bool operator()(const T* k, const T* camera, const T* board, T* residual) const {
     const T point[3] = {T(object[0]), T(object[1]), T(object[2])};
-    T world[3], local[3];
+    T world[3];
     ceres::AngleAxisRotatePoint(board, point, world);
     for (int i = 0; i < 3; ++i) world[i] += board[3 + i];
-    ceres::AngleAxisRotatePoint(camera, world, local);
-    for (int i = 0; i < 3; ++i) local[i] += camera[3 + i];
-    const T x = local[0] / local[2], y = local[1] / local[2];
-    const T r2 = x * x + y * y, r4 = r2 * r2, r6 = r4 * r2;
-    const T radial =
-        (T(1) + k[4] * r2 + k[5] * r4 + k[8] * r6) / (T(1) + k[9] * r2 + k[10] * r4 + k[11] * r6);
-    const T xd = x * radial + T(2) * k[6] * x * y + k[7] * (r2 + T(2) * x * x);
-    const T yd = y * radial + k[6] * (r2 + T(2) * y * y) + T(2) * k[7] * x * y;
-    residual[0] = k[0] * xd + k[2] - T(pixel[0]);
-    residual[1] = k[1] * yd + k[3] - T(pixel[1]);
+    reproject(k, camera, world, pixel, residual);
+    return true;
+  }
+};
+
+// A free point seen by a camera, scaled by the sighting's weight.
+struct PointReprojection {
+  std::array<double, 2> pixel;
+  double weight;
+
+  template <typename T>
+  bool operator()(const T* k, const T* camera, const T* point, T* residual) const {
+    reproject(k, camera, point, pixel, residual);
+    residual[0] *= T(weight);
+    residual[1] *= T(weight);
+    return true;
+  }
+};
+
+// Two points a shared length apart.
+struct LinkResidual {
+  double weight;
+
+  template <typename T>
+  bool operator()(const T* a, const T* b, const T* length, T* residual) const {
+    const T d[3] = {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
+    residual[0] =
+        T(weight) * (ceres::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2] + T(1e-12)) - length[0]);
     return true;
   }
 };
@@ -83,10 +120,14 @@ void bundle_adjust(BundleProblem& problem, std::vector<double>& errors) {
   for (const Pose& p : problem.camera_poses) cameras.push_back(block(p));
   for (const Pose& p : problem.board_poses) boards.push_back(block(p));
 
-  ceres::Problem solver;
-  // Corners are found to a fraction of a pixel: past 1 px an error grows linearly (a wrong
-  // corner pulls less before the outlier round drops it).
-  ceres::LossFunction* loss = new ceres::HuberLoss(1.0);
+  // Corners are found to a fraction of a pixel: past 1 px (loss_px) an error grows linearly (a
+  // wrong corner pulls less before the outlier round drops it). One loss for all the blocks,
+  // owned here.
+  ceres::Problem::Options problem_options;
+  problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  ceres::HuberLoss loss_function(problem.loss_px);
+  ceres::LossFunction* loss = &loss_function;
+  ceres::Problem solver(problem_options);
   for (const CornerObservation& o : problem.corners) {
     if (!o.active) continue;
     auto* cost = new ceres::AutoDiffCostFunction<Reprojection, 2, kIntrinsics, 6, 6>(
@@ -94,6 +135,24 @@ void bundle_adjust(BundleProblem& problem, std::vector<double>& errors) {
     solver.AddResidualBlock(cost, loss, intrinsics[o.camera].data(), cameras[o.camera].data(),
                             boards[o.frame].data());
   }
+  std::vector<std::array<double, 3>>& points = problem.points;
+  for (const PointSighting& o : problem.sightings) {
+    if (!o.active) continue;
+    auto* cost = new ceres::AutoDiffCostFunction<PointReprojection, 2, kIntrinsics, 6, 3>(
+        new PointReprojection{o.pixel, o.weight});
+    solver.AddResidualBlock(cost, loss, intrinsics[o.camera].data(), cameras[o.camera].data(),
+                            points[o.point].data());
+  }
+  for (const LengthLink& link : problem.links) {
+    if (!solver.HasParameterBlock(points[link.a].data()) ||
+        !solver.HasParameterBlock(points[link.b].data()))
+      continue;
+    auto* cost = new ceres::AutoDiffCostFunction<LinkResidual, 1, 3, 3, 1>(
+        new LinkResidual{problem.link_weight_px_per_m});
+    solver.AddResidualBlock(cost, nullptr, points[link.a].data(), points[link.b].data(),
+                            &problem.lengths[link.length]);
+  }
+  // Every residual added: now each camera's intrinsics are held or refined.
   for (std::size_t c = 0; c < cameras.size(); ++c) {
     if (!solver.HasParameterBlock(intrinsics[c].data())) continue;
     if (problem.refine_intrinsics) {
@@ -105,11 +164,15 @@ void bundle_adjust(BundleProblem& problem, std::vector<double>& errors) {
       solver.SetParameterBlockConstant(intrinsics[c].data());
     }
   }
+  if (problem.fixed_length < problem.lengths.size() &&
+      solver.HasParameterBlock(&problem.lengths[problem.fixed_length]))
+    solver.SetParameterBlockConstant(&problem.lengths[problem.fixed_length]);
   if (solver.HasParameterBlock(cameras[problem.fixed_camera].data()))
     solver.SetParameterBlockConstant(cameras[problem.fixed_camera].data());
 
   ceres::Solver::Options options;
-  options.linear_solver_type = ceres::DENSE_SCHUR;  // few cameras, many boards
+  // Few cameras, many boards: dense Schur. Many free points, some linked: sparse.
+  options.linear_solver_type = problem.points.empty() ? ceres::DENSE_SCHUR : ceres::SPARSE_SCHUR;
   options.max_num_iterations = 200;
   options.function_tolerance = 1e-10;
   options.parameter_tolerance = 1e-10;
@@ -123,7 +186,8 @@ void bundle_adjust(BundleProblem& problem, std::vector<double>& errors) {
   }
   for (std::size_t b = 0; b < boards.size(); ++b) problem.board_poses[b] = pose(boards[b]);
 
-  errors.assign(problem.corners.size(), std::numeric_limits<double>::quiet_NaN());
+  errors.assign(problem.corners.size() + problem.sightings.size(),
+                std::numeric_limits<double>::quiet_NaN());
   for (std::size_t i = 0; i < problem.corners.size(); ++i) {
     const CornerObservation& o = problem.corners[i];
     if (!o.active) continue;
@@ -132,6 +196,58 @@ void bundle_adjust(BundleProblem& problem, std::vector<double>& errors) {
                                       boards[o.frame].data(), r);
     errors[i] = std::hypot(r[0], r[1]);
   }
+  for (std::size_t i = 0; i < problem.sightings.size(); ++i) {
+    const PointSighting& o = problem.sightings[i];
+    if (!o.active) continue;
+    double r[2];
+    PointReprojection{o.pixel, 1.0}(intrinsics[o.camera].data(), cameras[o.camera].data(),
+                                    points[o.point].data(), r);
+    errors[problem.corners.size() + i] = std::hypot(r[0], r[1]);
+  }
+}
+
+bool drop_outliers(BundleProblem& problem, const std::vector<double>& errors, double factor,
+                   double floor_px) {
+  std::vector<double> active;
+  for (double e : errors)
+    if (std::isfinite(e)) active.push_back(e);
+  if (active.empty()) return false;
+  std::nth_element(active.begin(), active.begin() + static_cast<long>(active.size() / 2),
+                   active.end());
+  const double limit = std::max(factor * active[active.size() / 2], floor_px);
+  bool dropped = false;
+  const std::size_t corners = problem.corners.size();
+  for (std::size_t i = 0; i < errors.size(); ++i) {
+    if (!std::isfinite(errors[i]) || errors[i] <= limit) continue;
+    if (i < corners)
+      problem.corners[i].active = false;
+    else
+      problem.sightings[i - corners].active = false;
+    dropped = true;
+  }
+  return dropped;
+}
+
+std::vector<CameraResiduals> camera_residuals(const BundleProblem& problem,
+                                              const std::vector<double>& errors) {
+  std::vector<CameraResiduals> out(problem.cameras.size());
+  std::vector<double> squared(problem.cameras.size(), 0.0);
+  const auto count = [&](std::size_t camera, bool active, double error) {
+    if (!active) {
+      ++out[camera].dropped;
+      return;
+    }
+    ++out[camera].observations;
+    squared[camera] += error * error;
+  };
+  for (std::size_t i = 0; i < problem.corners.size(); ++i)
+    count(problem.corners[i].camera, problem.corners[i].active, errors[i]);
+  for (std::size_t i = 0; i < problem.sightings.size(); ++i)
+    count(problem.sightings[i].camera, problem.sightings[i].active,
+          errors[problem.corners.size() + i]);
+  for (std::size_t c = 0; c < out.size(); ++c)
+    if (out[c].observations > 0) out[c].rms_px = std::sqrt(squared[c] / out[c].observations);
+  return out;
 }
 
 }  // namespace mocap::camera::rig_calibration_detail

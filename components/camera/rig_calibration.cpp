@@ -333,13 +333,6 @@ glm::dmat3 to_glm(const cv::Matx33d& m) {
   return out;
 }
 
-double median(std::vector<double> values) {
-  if (values.empty()) return 0.0;
-  std::nth_element(values.begin(), values.begin() + static_cast<long>(values.size() / 2),
-                   values.end());
-  return values[values.size() / 2];
-}
-
 void check(const RigBoardOptions& o) {
   check_board(o.board);
   if (o.step < 1) throw std::invalid_argument("rig calibration: step must be at least 1");
@@ -505,16 +498,8 @@ RigCalibration calibrate_rig(const std::vector<CameraBoardViews>& all_views,
     report(options, "bundle adjustment", static_cast<double>(round) / (options.outlier_rounds + 1));
     bundle_adjust(problem, errors);
     if (round == options.outlier_rounds) break;
-    std::vector<double> active;
-    for (double e : errors)
-      if (std::isfinite(e)) active.push_back(e);
     // Never below half a pixel: on clean data 3x the median would cut into the good corners.
-    const double limit = std::max(options.outlier_factor * median(active), 0.5);
-    bool dropped = false;
-    for (std::size_t c = 0; c < errors.size(); ++c)
-      if (std::isfinite(errors[c]) && errors[c] > limit)
-        problem.corners[c].active = false, dropped = true;
-    if (!dropped) break;
+    if (!drop_outliers(problem, errors, options.outlier_factor, 0.5)) break;
   }
   report(options, "bundle adjustment", 1.0);
 

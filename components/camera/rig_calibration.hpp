@@ -123,18 +123,58 @@ struct CornerObservation {
   bool active = true;  // false once dropped as an outlier
 };
 
+// A free 3D point (a person's joint in one frame, camera/people_calibration) seen by one camera.
+struct PointSighting {
+  std::size_t camera = 0;
+  std::size_t point = 0;  // index into BundleProblem::points
+  std::array<double, 2> pixel{};
+  double weight = 1.0;  // the residual's scale (a keypoint's confidence)
+  bool active = true;   // false once dropped as an outlier
+};
+
+// Two points held `length` apart, the length a free parameter shared by every link of the same
+// bone (a person's bones keep their length from frame to frame).
+struct LengthLink {
+  std::size_t a = 0, b = 0;  // indices into BundleProblem::points
+  std::size_t length = 0;    // index into BundleProblem::lengths
+};
+
 struct BundleProblem {
   std::vector<Camera> cameras;     // intrinsics; pose ignored (see camera_poses)
   std::vector<Pose> camera_poses;  // world -> camera
   std::vector<Pose> board_poses;   // board -> world
   std::vector<CornerObservation> corners;
+  // Free points and their sightings (calibration from people; empty for a board).
+  std::vector<std::array<double, 3>> points;  // world, metres
+  std::vector<PointSighting> sightings;
+  std::vector<double> lengths;  // metres
+  std::vector<LengthLink> links;
+  double link_weight_px_per_m = 0.0;  // a link's residual: weight x (|a - b| - length)
+  // The length held (the scale's gauge: the reprojections do not see the scale, the links would
+  // shrink the world to nothing); none: lengths.size().
+  std::size_t fixed_length = 0;
+  double loss_px = 1.0;          // Huber: past this an error grows linearly
   std::size_t fixed_camera = 0;  // its pose is held (the gauge)
   bool refine_intrinsics = false;
 };
 
-// Solves in place (Ceres, rig_bundle_adjustment.cpp); returns each active corner's reprojection
-// error (px) in `errors` (inactive: NaN).
+// Solves in place (Ceres, rig_bundle_adjustment.cpp); returns the reprojection error (px) of each
+// active corner, then of each active sighting, in `errors` (corners.size() + sightings.size();
+// inactive: NaN).
 void bundle_adjust(BundleProblem& problem, std::vector<double>& errors);
+
+// One outlier round: deactivates the corners and sightings whose error exceeds
+// max(factor x the median error, floor_px); whether any was.
+bool drop_outliers(BundleProblem& problem, const std::vector<double>& errors, double factor,
+                   double floor_px);
+
+// Each camera's RMS error over its active observations, with their count and the inactive ones.
+struct CameraResiduals {
+  int observations = 0, dropped = 0;
+  double rms_px = 0.0;
+};
+std::vector<CameraResiduals> camera_residuals(const BundleProblem& problem,
+                                              const std::vector<double>& errors);
 
 }  // namespace rig_calibration_detail
 }  // namespace mocap::camera

@@ -15,6 +15,7 @@
 
 #include "camera/rig_file.hpp"
 #include "support/mocap_process.hpp"
+#include "support/shared_data.hpp"
 #include "support/virtual_rig.hpp"
 
 namespace mocap {
@@ -80,6 +81,32 @@ TEST(CalibrateRigCommand, WritesTheRigOfFourVirtualCameras) {
   EXPECT_NE(unreadable.err().find(dir.file("nowhere") + ": no such file or folder (camera cam_02)"),
             std::string::npos)
       << unreadable.err();
+}
+
+// From people: Pose2Sim's static trial (one person standing still, 12 frames) is refused with the
+// reason; the intrinsics must come from somewhere.
+TEST(CalibrateRigCommand, FromPeopleRefusesOnePersonStandingStill) {
+  MOCAP_REQUIRE_SHARED("eval/pose2sim_demo/S00_P00_T00_StaticTrial/pose/cam01_json");
+  const auto demo = test::shared_data() / "eval" / "pose2sim_demo";
+  test::TempDir dir;
+  std::vector<std::string> command{"calibrate", "rig", "--from-people", "--intrinsics",
+                                   (demo / "calibration" / "Calib_qualisys.toml").string()};
+  for (int k = 1; k <= 4; ++k)
+    command.push_back(
+        (demo / "S00_P00_T00_StaticTrial" / "pose" / ("cam0" + std::to_string(k) + "_json"))
+            .string());
+  command.emplace_back("--out");
+  command.push_back(dir.file("rig.toml"));
+  test::Mocap still(dir, "still", command);
+  EXPECT_NE(still.wait(60s), 0);
+  EXPECT_NE(still.err().find("the person hardly moves"), std::string::npos) << still.err();
+  EXPECT_FALSE(std::filesystem::exists(dir.file("rig.toml")));
+
+  command.erase(command.begin() + 3, command.begin() + 5);  // no --intrinsics, no --hfov
+  test::Mocap bare(dir, "bare", command);
+  EXPECT_NE(bare.wait(60s), 0);
+  EXPECT_NE(bare.err().find("give one of --intrinsics and --hfov"), std::string::npos)
+      << bare.err();
 }
 
 }  // namespace

@@ -16,11 +16,13 @@
 #include <iomanip>
 #include <iostream>
 #include <sstream>
+#include <string_view>
 #include <tuple>
 #include <utility>
 
 #include <glm/geometric.hpp>
 
+#include "calibration/people_calibration.hpp"
 #include "camera/board.hpp"
 #include "camera/camera_file.hpp"
 #include "camera/charuco_calibration.hpp"
@@ -34,6 +36,7 @@
 #include "core/input_error.hpp"
 #include "eval/layout_calibration.hpp"
 #include "eval_report.hpp"
+#include "io/openpose_json.hpp"
 #include "progress_bar.hpp"
 
 namespace mocap::cli {
@@ -477,9 +480,134 @@ Range outlier_range() {
   return r;
 }
 
-int rig_board_command(int argc, char** argv) {
+// `mocap calibrate rig --from-people`: the extrinsics from the people the views show
+// (calibration/people_calibration.hpp).
+int rig_people_command(int argc, char** argv) {
   Args args(
-      "mocap calibrate rig VIEW1 VIEW2 ... [--board charuco ...] --square MM --out RIG.toml",
+      "mocap calibrate rig --from-people (--intrinsics RIG | --hfov DEG --size WxH) VIEW1 VIEW2 "
+      "... --out RIG.toml [--height M]",
+      "Calibrates the cameras' poses from the people they film: one OpenPose JSON folder per "
+      "camera, in\nthe rig's order and in step (JSON index i of every view taken at the same "
+      "instant). Takes\nthe person in each view and frame, the relative pose of the "
+      "best-connected pair of cameras\n(essential matrix, RANSAC) and the others by PnP, then "
+      "one bundle adjustment over the camera\nposes and the joints of every frame used, the "
+      "bones' lengths held constant over the frames\n(keypoints off by more than --outlier x "
+      "the median dropped and the solve repeated). Metres\nfrom --height (default: the "
+      "canonical body's); the world from the feet: floor z = 0, z up,\norigin under the "
+      "people's mean position, x along the first camera's heading. Prints each\ncamera's RMS "
+      "reprojection error and writes the rig (docs/cameras.md). The people must move\nthrough "
+      "the space (one person standing still is refused).");
+  args.positional("views", "an OpenPose JSON folder per camera, in the rig's order", true);
+  args.flag("from-people", "calibrate from the people in view (this command)")
+      .option("intrinsics", "RIG",
+              "each camera's matrix, distortion and size from this rig file, camera k for view k "
+              "(its poses are ignored)")
+      .option("hfov", "DEG",
+              "without --intrinsics: every camera a pinhole of this horizontal field of view, "
+              "without distortion",
+              std::nullopt, Range::between(1.0, 179.0))
+      .option("size", "WxH", "with --hfov: the images' size in pixels", std::nullopt,
+              Range::image_size())
+      .option("cameras", "NAMES",
+              "comma-separated camera names, one per view (default: those of --intrinsics, "
+              "else cam_01, cam_02, ...)")
+      .option("layout", "NAME", "the JSON's 25-keypoint layout: auto, BODY_25 or BODY_25B", "auto")
+      .option("height", "M",
+              "the person's height, metres, as the 15-joint skeleton measures it: head top to sole "
+              "along the bones (default: the canonical body's, 1.52 m; docs/cameras.md)",
+              std::nullopt, Range::between(0.5, 2.5))
+      .option("outlier", "X", "drop keypoints whose error exceeds X times the median (> 1)", "3",
+              outlier_range())
+      .option("min-shared", "N", "frames with a person each camera must share with another", "20",
+              Range::count(1))
+      .option("out", "FILE", "where to write the rig (.toml or .yml; nothing written when absent)");
+  int code = 0;
+  if (!args.parse(argc, argv, code)) return code;
+  const std::vector<std::string>& views = args.positionals();
+  if (views.size() < 2) throw InputError("mocap calibrate rig", "give at least 2 views");
+  if (args.has("out")) camera::rig_format_for_writing(args.get("out"));  // a bad name fails now
+  if (args.has("intrinsics") == args.has("hfov"))
+    throw InputError("mocap calibrate rig --from-people", "give one of --intrinsics and --hfov");
+
+  std::vector<camera::Camera> cameras;
+  if (args.has("intrinsics")) {
+    const std::string file = args.get("intrinsics");
+    const camera::Rig rig = camera::read_rig(file);
+    if (rig.cameras.size() < views.size())
+      throw InputError(file, "has " + std::to_string(rig.cameras.size()) + " cameras for " +
+                                 std::to_string(views.size()) + " views (camera k for view k)");
+    cameras.assign(rig.cameras.begin(), rig.cameras.begin() + static_cast<long>(views.size()));
+  } else {
+    if (!args.has("size")) throw InputError("--hfov", "needs the images' size (--size WxH)");
+    const ImageSize size = args.image_size("size");
+    for (std::size_t i = 0; i < views.size(); ++i)
+      cameras.push_back(camera::Camera::from_fov(
+          size.width, size.height, args.number("hfov"),
+          std::string("cam_") + (i < 9 ? "0" : "") + std::to_string(i + 1)));
+  }
+  if (args.has("cameras")) {
+    std::stringstream list(args.get("cameras"));
+    std::vector<std::string> names;
+    for (std::string name; std::getline(list, name, ',');) names.push_back(name);
+    if (names.size() != views.size())
+      throw InputError("--cameras", std::to_string(names.size()) + " names for " +
+                                        std::to_string(views.size()) + " views");
+    for (std::size_t i = 0; i < views.size(); ++i) cameras[i].name = names[i];
+  }
+
+  const std::string layout = args.get("layout");
+  if (layout != "auto" && layout != "BODY_25" && layout != "BODY_25B")
+    throw InputError("--layout", "expected auto, BODY_25 or BODY_25B, got '" + layout + "'");
+  io::OpenPoseOptions json_options;
+  json_options.body25 = layout == "auto"       ? io::Body25Choice::detect
+                        : layout == "BODY_25B" ? io::Body25Choice::body25b
+                                               : io::Body25Choice::body25;
+  std::vector<camera::BodySequence> sequences;
+  for (const std::string& folder : views) {
+    const io::OpenPoseSequence json = io::read_openpose_folder(folder, json_options);
+    for (const io::FrameProblem& p : json.problems)
+      std::cerr << "mocap calibrate rig: " << folder << ": " << p.message << "\n";
+    sequences.push_back(camera::body_sequence(json.frames));
+  }
+
+  calibration::PeopleCalibrationOptions options;
+  if (args.has("height")) options.height_m = args.number("height");
+  options.outlier_factor = args.number("outlier");
+  options.min_shared_frames = static_cast<int>(args.integer("min-shared"));
+  const calibration::PeopleCalibration result =
+      calibration::calibrate_rig_from_people(cameras, sequences, views, options);
+
+  std::cout << result.frames_used << " frames in the bundle adjustment; person height "
+            << fixed(result.height_m, 3) << " m; motion " << fixed(result.motion, 3)
+            << " body heights\n";
+  for (const std::string& note : result.notes) std::cout << "note: " << note << "\n";
+  std::cout << "\n| camera | frames | keypoints used | dropped | RMS px | position m |\n"
+               "|---|---:|---:|---:|---:|---|\n";
+  for (std::size_t k = 0; k < result.rig.cameras.size(); ++k) {
+    const camera::Camera& c = result.rig.cameras[k];
+    const auto& r = result.cameras[k];
+    const glm::dvec3 p = c.centre();
+    std::cout << "| " << c.name << " | " << r.frames << " | " << r.observations << " | "
+              << r.dropped << " | " << fixed(r.rms_px, 2) << " | " << fixed(p.x, 3) << " "
+              << fixed(p.y, 3) << " " << fixed(p.z, 3) << " |\n";
+  }
+  std::cout << "\nRMS reprojection error " << fixed(result.rms_px, 2) << " px\n";
+  if (args.has("out")) {
+    const fs::path out = args.get("out");
+    if (out.has_parent_path()) fs::create_directories(out.parent_path());
+    camera::write_rig(out, result.rig);
+    camera::read_rig(out);  // what was written reads back
+    std::cout << "wrote " << out.string() << "\n";
+  }
+  return 0;
+}
+
+int rig_board_command(int argc, char** argv) {
+  for (int i = 0; i < argc; ++i)
+    if (std::string_view(argv[i]) == "--from-people") return rig_people_command(argc, argv);
+  Args args(
+      "mocap calibrate rig VIEW1 VIEW2 ... [--board charuco ...] --square MM --out RIG.toml\n"
+      "       mocap calibrate rig --from-people ... (see mocap calibrate rig --from-people --help)",
       "Calibrates several cameras together from a chessboard or ChArUco board that they all "
       "film: one\nview per camera (a video, or a folder of images in name order), in step "
       "(frame i of every view\ntaken at the same instant). Finds the board in every --step-th "
@@ -598,7 +726,9 @@ int calibrate_command(int argc, char** argv) {
        intrinsics_command},
       {"ground", "the floor from an image of a board lying on it (added to the camera file)",
        ground_command},
-      {"rig", "several cameras in one world from a board they all film (a rig file)",
+      {"rig",
+       "several cameras in one world from a board they all film, or from the people in view "
+       "(--from-people; a rig file)",
        rig_board_command},
   };
   return run_subcommand("calibrate", kSubcommands, argc, argv);
