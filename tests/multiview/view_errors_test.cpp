@@ -1,5 +1,6 @@
-// multiview::view_errors on a virtual rig: four cameras around a person, keypoints projected
-// through the true cameras with 1 px of noise; the rig handed over has one camera turned by 1°.
+// multiview::view_errors on a virtual rig: four cameras 75° apart around a person (no two facing
+// each other: opposite cameras triangulate poorly together), keypoints projected
+// through the true cameras with 1 px of noise; the rig handed over has one camera turned by 2°.
 // That camera, and only that one, is far worse than the rest.
 
 #include <gtest/gtest.h>
@@ -40,7 +41,8 @@ struct Scene {
 Scene scene(int frames) {
   Scene s;
   for (int i = 0; i < 4; ++i)
-    s.cameras.push_back(looking_at_origin(i * M_PI / 2 + 0.3, "cam_0" + std::to_string(i + 1)));
+    s.cameras.push_back(
+        looking_at_origin(i * glm::radians(75.0) + 0.3, "cam_0" + std::to_string(i + 1)));
   s.views.resize(4);
   std::mt19937 random(7);
   std::uniform_real_distribution<double> box(-0.4, 0.4), height(0.1, 1.8);
@@ -60,10 +62,13 @@ Scene scene(int frames) {
   return s;
 }
 
-TEST(ViewErrors, ACameraTurnedByOneDegreeIsFlaggedAndTheOthersAreNot) {
+TEST(ViewErrors, ACameraTurnedByTwoDegreesIsFlaggedAndTheOthersAreNot) {
   Scene s = scene(40);
   std::vector<camera::Camera> rig = s.cameras;
-  rig[2].rotation = camera::rotation_from_rodrigues({0, glm::radians(1.0), 0}) * rig[2].rotation;
+  // Turned where it stands (its centre kept).
+  const glm::dvec3 centre = rig[2].centre();
+  rig[2].rotation = camera::rotation_from_rodrigues({0, glm::radians(2.0), 0}) * rig[2].rotation;
+  rig[2].translation = -(rig[2].rotation * centre);
   const ViewErrorReport report = view_errors(rig, s.views);
   EXPECT_EQ(report.frames, 40u);
   EXPECT_EQ(report.frames_used, 40u);
@@ -71,8 +76,9 @@ TEST(ViewErrors, ACameraTurnedByOneDegreeIsFlaggedAndTheOthersAreNot) {
     EXPECT_EQ(report.views[v].points, 40u * kBodyJoints) << v;
     EXPECT_EQ(report.views[v].flagged, v == 2) << v << ": " << report.views[v].median_px;
   }
-  // 1° at f = 1000 px: about 17 px; the others near their noise.
-  EXPECT_GT(report.views[2].median_px, 10.0);
+  // 2° at f = 1000 px: about 35 px; the others near their noise (the turned camera, 14 cm off at
+  // 4 m, is left out of their triangulation).
+  EXPECT_GT(report.views[2].median_px, 25.0);
   for (std::size_t v : {0u, 1u, 3u}) EXPECT_LT(report.views[v].median_px, 5.0) << v;
 }
 

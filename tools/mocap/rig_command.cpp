@@ -43,7 +43,11 @@ void print_view_errors(const camera::Rig& rig, const std::string& file,
   for (std::size_t v = 0; v < folders.size(); ++v) {
     try {
       const io::OpenPoseSequence json = io::read_openpose_folder(folders[v], options);
-      if (json.frames.empty()) throw InputError(folders[v], "no frames");
+      for (const io::FrameProblem& p : json.problems)
+        std::cerr << "mocap rig info: " << folders[v] << ": " << p.message << "\n";
+      const bool people = std::any_of(json.frames.begin(), json.frames.end(),
+                                      [](const People2D& f) { return !f.people.empty(); });
+      if (!people) throw InputError(folders[v], "no person in any of its frames");
       views.push_back(camera::body_sequence(json.frames));
       cameras.push_back(rig.cameras[v]);
       index.push_back(v);
