@@ -74,6 +74,12 @@ class Contract {
                        max_count});
   }
 
+  // A repeated input accepting every message type (a generic joining sink).
+  void inputs_any(std::string name, std::string doc, std::size_t min_count, std::size_t max_count) {
+    add_input(PortSpec{
+        std::move(name), {}, {}, min_count == 0, std::move(doc), true, min_count, max_count});
+  }
+
   template <class T>
   void output(std::string name, std::string doc = {}) {
     add_output(PortSpec{std::move(name), std::string(T::kTypeName), {}, false, std::move(doc)});

@@ -38,6 +38,12 @@ std::string format_sync_stats(const SyncStats& sync) {
   std::ostringstream out;
   out << "joined " << sync.sets << " sets (" << sync.complete << " complete)";
   if (sync.restarts) out << ", " << sync.restarts << " restarts";
+  if (sync.skew_sets) {
+    char skew[96];
+    std::snprintf(skew, sizeof skew, ", skew p50 %.1f ms p95 %.1f ms max %.1f ms", sync.skew_p50_ms,
+                  sync.skew_p95_ms, sync.skew_max_ms);
+    out << skew;
+  }
   for (const SyncInputStats& input : sync.inputs) {
     out << "; " << input.name << ": " << input.missing << " missing";
     if (input.late) out << ", " << input.late << " late";

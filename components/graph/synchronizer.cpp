@@ -134,6 +134,39 @@ void Synchronizer::take(std::int64_t key, SyncSet& set) {
   }
   ++stats_.sets;
   if (set.complete()) ++stats_.complete;
+  count_skew(set);
+}
+
+void Synchronizer::count_skew(const SyncSet& set) {
+  std::int64_t oldest = std::numeric_limits<std::int64_t>::max();
+  std::int64_t newest = std::numeric_limits<std::int64_t>::min();
+  std::size_t timed = 0;
+  for (const Packet& packet : set.packets) {
+    if (!packet.message || packet.header().capture_ns == 0) continue;  // 0: no capture time
+    oldest = std::min(oldest, packet.header().capture_ns);
+    newest = std::max(newest, packet.header().capture_ns);
+    ++timed;
+  }
+  if (timed < 2) return;
+  // Saturated: capture times come from outside.
+  const std::int64_t skew = static_cast<std::int64_t>(
+      std::min<std::uint64_t>(distance(oldest, newest), std::numeric_limits<std::int64_t>::max()));
+  skews_[stats_.skew_sets % kSkewSamples] = skew;
+  ++stats_.skew_sets;
+  skew_max_ns_ = std::max(skew_max_ns_, skew);
+}
+
+SyncStats Synchronizer::stats() const {
+  SyncStats stats = stats_;
+  if (stats.skew_sets == 0) return stats;
+  const std::size_t n =
+      static_cast<std::size_t>(std::min<std::uint64_t>(stats.skew_sets, kSkewSamples));
+  const std::vector<std::int64_t> skews(skews_.begin(),
+                                        skews_.begin() + static_cast<std::ptrdiff_t>(n));
+  stats.skew_p50_ms = percentile(skews, 50) / 1e6;
+  stats.skew_p95_ms = percentile(skews, 95) / 1e6;
+  stats.skew_max_ms = static_cast<double>(skew_max_ns_) / 1e6;
+  return stats;
 }
 
 // Everything held goes on as it is, oldest first, and joining starts afresh.

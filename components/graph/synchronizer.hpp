@@ -25,6 +25,7 @@
 // (the 2D people and, behind a slower chain, their 3D), waiting could deadlock (the source waits
 // for this node, the slow branch for the source), so the runtime uses pass_partial there.
 
+#include <array>
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
@@ -63,6 +64,7 @@ struct SyncSet {
 class Synchronizer {
  public:
   using Clock = std::chrono::steady_clock;
+  static constexpr std::size_t kSkewSamples = 1024;
 
   // Throws std::invalid_argument for no inputs or a zero bound.
   Synchronizer(std::size_t inputs, SyncOptions options);
@@ -84,7 +86,8 @@ class Synchronizer {
   // Every input has ended and everything was passed on.
   bool finished() const;
 
-  const SyncStats& stats() const { return stats_; }
+  // The counters, with the skew percentiles over the last kSkewSamples sets.
+  SyncStats stats() const;
   const SyncOptions& options() const { return options_; }
   std::size_t inputs() const { return inputs_.size(); }
 
@@ -107,11 +110,14 @@ class Synchronizer {
   bool settled(const Input& input, std::int64_t anchor) const;
   void take(std::int64_t anchor, SyncSet& set);
   void restart();
+  void count_skew(const SyncSet& set);
 
   SyncOptions options_;
   std::vector<Input> inputs_;
   std::deque<SyncSet> ready_;  // late messages and sets flushed by a restart, passed on first
   SyncStats stats_;
+  std::array<std::int64_t, kSkewSamples> skews_{};  // a ring: the last sets' skews (ns)
+  std::int64_t skew_max_ns_ = 0;
 };
 
 }  // namespace mocap::graph

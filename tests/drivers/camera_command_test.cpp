@@ -1,5 +1,5 @@
 // `mocap camera list|grab` driven as a user would, against the fake GigE camera; and the live
-// GigE graph validated by `mocap graph validate`.
+// GigE graphs (one camera, several) validated by `mocap graph validate`.
 
 #include <gtest/gtest.h>
 
@@ -88,6 +88,16 @@ TEST(LiveGigeGraph, Validates) {
   TempDir dir;
   Mocap validate(dir, "validate", {"graph", "validate", "graphs/live_gige.yaml"});
   ASSERT_EQ(validate.wait(30s), 0) << validate.err() << validate.out();
+}
+
+// The live multi-view graphs (several cameras joined by capture time) as shipped.
+TEST(LiveMultiviewGraphs, Validate) {
+  TempDir dir;
+  for (const char* graph :
+       {"graphs/live_multiview_gige.yaml", "graphs/live_multiview_webcam.yaml"}) {
+    Mocap validate(dir, "validate", {"graph", "validate", graph});
+    ASSERT_EQ(validate.wait(30s), 0) << graph << "\n" << validate.err() << validate.out();
+  }
 }
 
 }  // namespace

@@ -67,12 +67,14 @@ class FakeCameraLock {
 
 class FakeGvCamera {
  public:
-  // Starts the camera with this serial (and `loss_per_thousand` GVSP packets dropped) and waits
-  // until Aravis discovers it. Throws when it does not appear within `timeout`.
+  // Starts the camera with this serial (and `loss_per_thousand` GVSP packets dropped) on this
+  // interface address and waits until Aravis discovers it. Throws when it does not appear within
+  // `timeout`. One camera per address (private_loopback.hpp gives loopback more).
   FakeGvCamera(const std::string& program, std::string serial, int loss_per_thousand = 0,
-               std::chrono::milliseconds timeout = std::chrono::seconds(15))
+               std::chrono::milliseconds timeout = std::chrono::seconds(15),
+               const std::string& address = "127.0.0.1")
       : serial_(std::move(serial)) {
-    std::vector<std::string> args = {program, "-i", "127.0.0.1", "-s", serial_};
+    std::vector<std::string> args = {program, "-i", address, "-s", serial_};
     if (loss_per_thousand > 0) {
       args.push_back("-r");
       args.push_back(std::to_string(loss_per_thousand));
@@ -92,7 +94,7 @@ class FakeGvCamera {
     if (pid_ < 0) throw std::runtime_error("fork failed");
     if (!wait_until_discovered(timeout)) {
       stop();
-      throw std::runtime_error("the fake camera " + serial_ + " did not appear on 127.0.0.1");
+      throw std::runtime_error("the fake camera " + serial_ + " did not appear on " + address);
     }
   }
   ~FakeGvCamera() { stop(); }

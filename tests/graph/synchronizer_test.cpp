@@ -188,6 +188,36 @@ TEST(Synchronizer, CaptureTimesWithinTheToleranceJoin) {
   EXPECT_EQ(apart[1].substr(apart[1].find(':')), ":1");
 }
 
+// The skew of a set: its newest minus its oldest capture time; sets of one member or without
+// capture times (0) give none.
+TEST(Synchronizer, EachSetsSkewIsCountedWithItsPercentilesAndMaximum) {
+  Synchronizer sync(3, {SyncKey::capture_time, 10'000'000, 0ns, 64, AtBound::wait});
+  const auto now = Clock::now();
+  for (std::int64_t i = 0; i < 100; ++i) {
+    const std::int64_t t = 1'000'000'000 + i * 33'000'000;
+    sync.push(0, message(i, t), now);
+    sync.push(1, message(i, t + 1'000'000), now);                      // 1 ms after
+    sync.push(2, message(i, t + (i == 50 ? 9 : 2) * 1'000'000), now);  // 2 ms, once 9 ms
+  }
+  const Sets sets = drain(sync);
+  EXPECT_EQ(sets.size(), 100u);
+  SyncStats stats = sync.stats();
+  EXPECT_EQ(stats.skew_sets, 100u);
+  EXPECT_DOUBLE_EQ(stats.skew_p50_ms, 2.0);
+  EXPECT_DOUBLE_EQ(stats.skew_p95_ms, 2.0);
+  EXPECT_DOUBLE_EQ(stats.skew_max_ms, 9.0);
+  EXPECT_NE(format_sync_stats(stats).find("skew p50 2.0 ms p95 2.0 ms max 9.0 ms"),
+            std::string::npos)
+      << format_sync_stats(stats);
+  // Without capture times: no skew.
+  Synchronizer frames(2, {});
+  frames.push(0, message(0), now);
+  frames.push(1, message(0), now);
+  EXPECT_EQ(drain(frames), Sets{"0:01"});
+  EXPECT_EQ(frames.stats().skew_sets, 0u);
+  EXPECT_EQ(format_sync_stats(frames.stats()).find("skew"), std::string::npos);
+}
+
 TEST(Synchronizer, AWallClockWaitLimitPassesAStalledSetOnAndItsLatePartAlone) {
   Synchronizer sync(2, {SyncKey::capture_time, 5'000'000, 50ms, 64, AtBound::wait});
   const auto t0 = Clock::now();

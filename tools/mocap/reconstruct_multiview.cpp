@@ -119,6 +119,27 @@ void check_video_view(View& view, const std::string& rig_file, const Args& args)
   view.fps = source.fps();
 }
 
+// The views are joined frame by frame: videos at different rates would drift apart (29.97 against
+// 30 fps: a frame every 33 s), so they are refused, naming both (not resampled: which frames to
+// drop or repeat is the user's choice, and a tool like ffmpeg -r does it once).
+void check_frame_rates(const std::vector<View>& views) {
+  const View* first = nullptr;
+  for (const View& v : views) {
+    if (v.kind == ViewKind::openpose_json || v.fps <= 0.0) continue;  // no rate of its own
+    if (!first) {
+      first = &v;
+    } else if (std::abs(v.fps - first->fps) > 1e-3 * first->fps) {
+      std::ostringstream what;
+      what << v.path << " is " << v.fps << " fps but " << first->path << " (camera '"
+           << first->camera->name << "') is " << first->fps
+           << " fps: the views are joined frame by frame, so they must share one frame rate; "
+              "resample one (e.g. ffmpeg -i IN -r "
+           << first->fps << " OUT) or record them at one rate";
+      throw InputError(v.camera->name, what.str());
+    }
+  }
+}
+
 // One view per rig camera, in its order: a camera without a view or a view without a camera is
 // refused, naming it.
 std::vector<View> match_views(const camera::Rig& rig, const std::vector<std::string>& paths,
@@ -342,6 +363,7 @@ int reconstruct_multiview_command(int argc, char** argv) {
     if (fps <= 0.0 && v.fps > 0.0) fps = v.fps;
     frames = std::max(frames, v.frames);
   }
+  check_frame_rates(views);
   if (fps <= 0.0) fps = 30.0;
   if (args.has("offsets")) apply_offsets(views, rig, args.get("offsets"));
   std::string floor_how;

@@ -1,7 +1,8 @@
-// `mocap rig info RIG`, `mocap rig convert IN OUT` and `mocap rig offsets RIG VIEW...`: what a
-// rig file (docs/cameras.md: the Pose2Sim/anipose TOML layout or OpenCV YAML) holds, the same rig
-// in the other format, and the frame offsets between views filmed without a common clock.
+// `mocap rig info RIG [VIEW...]`, `mocap rig convert IN OUT` and `mocap rig offsets RIG VIEW...`:
+// what a rig file (docs/cameras.md: the Pose2Sim/anipose TOML layout or OpenCV YAML) holds, the
+// same rig in the other format, and the frame offsets between views filmed without a common clock.
 
+#include <algorithm>
 #include <cstdio>
 #include <iostream>
 
@@ -12,25 +13,105 @@
 #include "commands.hpp"
 #include "core/input_error.hpp"
 #include "io/openpose_json.hpp"
+#include "multiview/view_errors.hpp"
 #include "view_offsets.hpp"
 
 namespace mocap::cli {
 namespace {
 
+io::OpenPoseOptions json_options(const std::string& layout) {
+  if (layout != "auto" && layout != "BODY_25" && layout != "BODY_25B")
+    throw InputError("--layout", "expected auto, BODY_25 or BODY_25B, got '" + layout + "'");
+  io::OpenPoseOptions options;
+  options.body25 = layout == "auto"       ? io::Body25Choice::detect
+                   : layout == "BODY_25B" ? io::Body25Choice::body25b
+                                          : io::Body25Choice::body25;
+  return options;
+}
+
+// Per camera, how far its keypoints lie from the joints triangulated from the other cameras. A
+// view that cannot be read is named and left out (its camera then has no error).
+void print_view_errors(const camera::Rig& rig, const std::string& file,
+                       const std::vector<std::string>& folders, const std::string& layout) {
+  if (folders.size() != rig.cameras.size())
+    throw InputError(file, std::to_string(rig.cameras.size()) + " cameras, " +
+                               std::to_string(folders.size()) +
+                               " views given: give one view per camera, in the rig's order");
+  const io::OpenPoseOptions options = json_options(layout);
+  std::vector<camera::Camera> cameras;
+  std::vector<camera::BodySequence> views;
+  std::vector<std::size_t> index;  // the rig's camera of each view read
+  for (std::size_t v = 0; v < folders.size(); ++v) {
+    try {
+      const io::OpenPoseSequence json = io::read_openpose_folder(folders[v], options);
+      for (const io::FrameProblem& p : json.problems)
+        std::cerr << "mocap rig info: " << folders[v] << ": " << p.message << "\n";
+      const bool people = std::any_of(json.frames.begin(), json.frames.end(),
+                                      [](const People2D& f) { return !f.people.empty(); });
+      if (!people) throw InputError(folders[v], "no person in any of its frames");
+      views.push_back(camera::body_sequence(json.frames));
+      cameras.push_back(rig.cameras[v]);
+      index.push_back(v);
+    } catch (const std::exception& e) {
+      std::cerr << "mocap rig info: " << e.what() << "; view " << v + 1 << " ("
+                << rig.cameras[v].name << ") skipped\n";
+    }
+  }
+  const multiview::ViewErrorReport report = multiview::view_errors(cameras, views);
+  std::cout << "\nreprojection error per camera: its keypoints against the joints triangulated "
+               "from the other\ncameras, over "
+            << report.frames_used << " of " << report.frames
+            << " frames (those with a person in every view; per view its tallest)\n\n"
+            << "| camera | points | median px | mean px | |\n|---|---|---|---|---|\n";
+  std::vector<std::string> flagged;
+  for (std::size_t v = 0; v < rig.cameras.size(); ++v) {
+    const auto it = std::find(index.begin(), index.end(), v);
+    char row[256];
+    if (it == index.end()) {
+      std::snprintf(row, sizeof row, "| %s | - | - | - | view not read |\n",
+                    rig.cameras[v].name.c_str());
+    } else {
+      const multiview::ViewError& e = report.views[static_cast<std::size_t>(it - index.begin())];
+      std::snprintf(row, sizeof row, "| %s | %zu | %.1f | %.1f | %s |\n",
+                    rig.cameras[v].name.c_str(), e.points, e.median_px, e.mean_px,
+                    e.flagged ? "far worse than the rest" : "");
+      if (e.flagged) flagged.push_back(rig.cameras[v].name);
+    }
+    std::cout << row;
+  }
+  if (views.size() < 3)
+    std::cout << "fewer than 3 views read: a camera's keypoints need two others to check them\n";
+  for (const std::string& name : flagged)
+    std::cout << name
+              << ": its median error is more than twice the others': check its calibration "
+                 "(pose, intrinsics, image size) and that its view is in the rig's order\n";
+}
+
 int info(int argc, char** argv) {
-  Args args("mocap rig info RIG",
+  Args args("mocap rig info RIG [VIEW1 VIEW2 ...] [--layout L]",
             "Prints a rig's cameras (name, image size, focal lengths, principal point, "
             "distortion), where they\nare in the world and where they look, the baselines and "
             "the angles between their optical axes\nfor every pair, and the floor (with each "
             "camera's height and tilt above it). RIG: a .toml\n(Pose2Sim, anipose, Caliscope, "
             "FreeMoCap) or OpenCV .yml rig file, or the single-camera file\nof `mocap calibrate "
-            "intrinsics`.");
-  args.positional("RIG", "the rig file");
+            "intrinsics`. Given keypoints (VIEW: an OpenPose JSON folder per camera, in\nthe "
+            "rig's order; at least 3), also the reprojection error per camera: its keypoints "
+            "against\nthe joints triangulated from the other cameras (median, mean, points), a "
+            "camera far worse\nthan the rest flagged (docs/cameras.md).");
+  args.positional("RIG", "the rig file")
+      .positional("VIEW", "OpenPose JSON folders, one per camera of the rig, in its order", true,
+                  false)
+      .option("layout", "L",
+              "25-keypoint files are BODY_25 or BODY_25B (Pose2Sim's); auto: told by the "
+              "keypoints, as source.openpose_json does",
+              "auto");
   int code = 0;
   if (!args.parse(argc, argv, code)) return code;
   const std::string file = args.positionals().at(0);
   const camera::Rig rig = camera::read_rig(file);
   std::cout << file << ": " << camera::rig_report(rig);
+  const std::vector<std::string> folders(args.positionals().begin() + 1, args.positionals().end());
+  if (!folders.empty()) print_view_errors(rig, file, folders, args.get("layout"));
   return 0;
 }
 
@@ -86,17 +167,11 @@ int offsets(int argc, char** argv) {
   if (reference >= folders.size())
     throw InputError("--reference", "view " + std::to_string(reference + 1) + " of " +
                                         std::to_string(folders.size()));
-  const std::string layout = args.get("layout");
-  if (layout != "auto" && layout != "BODY_25" && layout != "BODY_25B")
-    throw InputError("--layout", "expected auto, BODY_25 or BODY_25B, got '" + layout + "'");
-  io::OpenPoseOptions json_options;
-  json_options.body25 = layout == "auto"       ? io::Body25Choice::detect
-                        : layout == "BODY_25B" ? io::Body25Choice::body25b
-                                               : io::Body25Choice::body25;
+  const io::OpenPoseOptions options_json = json_options(args.get("layout"));
   camera::OffsetOptions options;
   options.max_offset_frames = static_cast<int>(args.integer("max-offset"));
   const ViewOffsets estimated =
-      estimate_view_offsets(rig, folders, json_options, reference, options, "mocap rig offsets");
+      estimate_view_offsets(rig, folders, options_json, reference, options, "mocap rig offsets");
   const std::vector<camera::ViewOffset>& found = estimated.offsets;
   std::cout
       << "| view | camera | frames | offset (frames) | contrast | epipolar cost (body heights) |\n"

@@ -1,8 +1,9 @@
-// multiview.reconstruct: several calibrated views of one scene, joined by frame, to the people in
-// the rig's world (multiview/rig_reconstruction.hpp: undistortion, association, triangulation,
-// tracking). People seen by one view only are dropped and counted. `fit`: each track's skeleton
-// fitted on all views (fit::MultiViewPeopleFitter: constant bones, live = fixed lag, full =
-// windows), one output per input set, in order.
+// multiview.reconstruct: several calibrated views of one scene, joined by frame (files) or by
+// capture time (live cameras: the graph sets sync_by, sync_tolerance_ms, sync_wait_ms), to the
+// people in the rig's world (multiview/rig_reconstruction.hpp: undistortion, association,
+// triangulation, tracking). People seen by one view only are dropped and counted. `fit`: each
+// track's skeleton fitted on all views (fit::MultiViewPeopleFitter: constant bones, live = fixed
+// lag, full = windows), one output per input set, in order.
 
 #include <iostream>
 #include <memory>
@@ -60,6 +61,8 @@ class MultiViewReconstructNode : public Node {
     }
     options.tracker.fps = ctx.param<double>("fps");
     options.report_tentative = ctx.param<bool>("report_tentative");
+    // Live cameras' frame counters are unrelated: the sets are numbered here instead.
+    number_sets_ = ctx.param<std::string>("sync_by") == "capture_time";
     solver_ = std::make_unique<multiview::RigReconstruction>(camera::read_rig(file), file, options);
     if (const auto mode = ctx.param<std::string>("fit"); mode != "off") {
       fit::MultiViewPeopleFitOptions o;
@@ -90,7 +93,11 @@ class MultiViewReconstructNode : public Node {
     People3D out;
     out.header = *header;
     out.header.stream = ctx.node_name();
-    solver_->solve(views_, header->frame, out);
+    if (number_sets_) {
+      out.header.seq = sets_;
+      out.header.frame = static_cast<std::int64_t>(sets_++);
+    }
+    solver_->solve(views_, out.header.frame, out);
     if (!fitter_) {
       ctx.send("out", std::move(out));
     } else {
@@ -124,6 +131,8 @@ class MultiViewReconstructNode : public Node {
   std::unique_ptr<multiview::RigReconstruction> solver_;
   std::optional<fit::MultiViewPeopleFitter> fitter_;
   std::vector<const People2D*> views_;
+  bool number_sets_ = false;
+  std::uint64_t sets_ = 0;
 };
 
 MOCAP_REGISTER_NODE("multiview.reconstruct", MultiViewReconstructNode)

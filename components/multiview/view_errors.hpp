@@ -1,0 +1,47 @@
+#pragma once
+// How well each camera of a rig agrees with the others, from keypoints (issue 19's "a camera
+// whose calibration is off", issue 20's `mocap rig info RIG VIEW...`): every joint seen by the
+// camera is triangulated from the *other* cameras alone (triangulate_robust: their consensus,
+// one of them far off left out) and reprojected into it; the distance to its own keypoint is its
+// error. A camera whose pose or intrinsics are off lands its keypoints
+// far from where the others put the joint, while the others, triangulated without it, stay
+// consistent. The check is done with one person walking through the space: per view and frame
+// the tallest person (the span of its confident keypoints) is taken as that person, so that no
+// association is needed (bystanders further away, partial detections are left out); frames in
+// which a view shows nobody are skipped.
+
+#include <span>
+#include <string>
+#include <vector>
+
+#include "camera/camera.hpp"
+#include "camera/frame_offsets.hpp"
+
+namespace mocap::multiview {
+
+struct ViewErrorOptions {
+  double min_confidence = 0.3;  // keypoints below are not used (Pose2Sim's likelihood threshold)
+  // A camera is flagged when its median error exceeds this many times the median of the other
+  // cameras' medians (and min_flag_px): far worse than the rest.
+  double flag_ratio = 2.0;
+  double min_flag_px = 5.0;
+};
+
+struct ViewError {
+  std::size_t points = 0;  // joints reprojected into this camera
+  double median_px = 0, mean_px = 0;
+  bool flagged = false;  // far worse than the rest (ViewErrorOptions)
+};
+
+struct ViewErrorReport {
+  std::vector<ViewError> views;  // one per camera, in order
+  std::size_t frames_used = 0;   // frames with a person in every view
+  std::size_t frames = 0;        // frames in the shortest view
+};
+
+// `views[v]` are camera v's frames (body_sequence: 15 joints, distorted pixels as read).
+ViewErrorReport view_errors(std::span<const camera::Camera> cameras,
+                            std::span<const camera::BodySequence> views,
+                            const ViewErrorOptions& options = {});
+
+}  // namespace mocap::multiview

@@ -1,0 +1,254 @@
+// mocap-bench-rig-live: several fake GigE cameras (Aravis' arv-fake-gv-camera-0.8, each its own
+// serial and loopback address, in a network namespace of this program's own) at one frame rate,
+// through source.aravis into sink.sets, joined by capture time (the synchroniser every live
+// multi-view graph uses), for --seconds. One camera is killed at a third of the run and started
+// again at half: the others must go on (their sets partial while it is away) and it must come
+// back. Prints one Markdown row per sample: sets, complete, missing per camera, skew p50/p95
+// (over the last 1024 sets) and max, drops, resident memory; then the verdict. No detector: the
+// fake frames have no people. A benchmark, not a test: it takes minutes.
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "cli_args.hpp"
+#include "drivers/fake_gv_camera.hpp"
+#include "drivers/private_loopback.hpp"
+#include "graph/graph_spec.hpp"
+#include "graph/runtime.hpp"
+#include "graph/validation.hpp"
+
+namespace {
+
+using namespace std::chrono_literals;
+using namespace mocap;
+using Clock = std::chrono::steady_clock;
+
+double rss_mib() {
+  std::ifstream in("/proc/self/status");
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind("VmRSS:", 0) == 0) return std::stod(line.substr(6)) / 1024.0;
+  }
+  return -1;
+}
+
+struct Settings {
+  int cameras = 4;
+  double fps = 30, tolerance_ms = 10, wait_ms = 200;
+  int width = 320, height = 240;
+};
+
+std::string graph_text(const Settings& s, const std::vector<std::string>& serials) {
+  std::string text = "graph: rig_live_bench\nnodes:\n";
+  char line[320];
+  for (std::size_t i = 0; i < serials.size(); ++i) {
+    std::snprintf(line, sizeof line,
+                  "  cam%zu: { type: source.aravis, params: { id: %s, fps: %g, width: %d, height: "
+                  "%d, pixel_format: Mono8, camera: cam%zu } }\n",
+                  i + 1, serials[i].c_str(), s.fps, s.width, s.height, i + 1);
+    text += line;
+  }
+  std::snprintf(line, sizeof line,
+                "  sets: { type: sink.sets, params: { sync_by: capture_time, sync_tolerance_ms: "
+                "%g, sync_wait_ms: %g } }\nedges:\n",
+                s.tolerance_ms, s.wait_ms);
+  text += line;
+  for (std::size_t i = 0; i < serials.size(); ++i) {
+    text += "  - [cam" + std::to_string(i + 1) + ".frames, sets.in:" + std::to_string(i) + "]\n";
+  }
+  return text;
+}
+
+struct Sample {
+  double t = 0;
+  std::string event;
+  graph::SyncStats sync;
+  std::uint64_t drops = 0;
+  double rss = 0;
+  std::string last_status;
+};
+
+// `watched`: the node whose status line is kept (the camera killed and restarted).
+Sample sample(const graph::Runtime& runtime, double t, std::string event,
+              const std::string& watched) {
+  Sample s;
+  s.t = t;
+  s.event = std::move(event);
+  s.rss = rss_mib();
+  for (const graph::NodeStats& n : runtime.stats().nodes) {
+    s.drops += n.drops;
+    if (n.node == "sets") s.sync = n.sync;
+    if (n.node == watched) s.last_status = n.status;
+  }
+  return s;
+}
+
+void print_header(int cameras) {
+  std::cout << "| t s | event | sets | complete |";
+  for (int i = 1; i <= cameras; ++i) std::cout << " cam" << i << " missing |";
+  std::cout << " skew p50 ms | skew p95 ms | skew max ms | drops | RSS MiB |\n|---|---|---|---|";
+  for (int i = 0; i < cameras; ++i) std::cout << "---|";
+  std::cout << "---|---|---|---|---|\n";
+}
+
+void print_row(const Sample& s) {
+  std::printf("| %.0f | %s | %llu | %llu |", s.t, s.event.c_str(),
+              static_cast<unsigned long long>(s.sync.sets),
+              static_cast<unsigned long long>(s.sync.complete));
+  for (const auto& input : s.sync.inputs)
+    std::printf(" %llu |", static_cast<unsigned long long>(input.missing));
+  std::printf(" %.2f | %.2f | %.2f | %llu | %.1f |\n", s.sync.skew_p50_ms, s.sync.skew_p95_ms,
+              s.sync.skew_max_ms, static_cast<unsigned long long>(s.drops), s.rss);
+  std::fflush(stdout);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  // Before any thread starts (user namespaces require a single-threaded process).
+  const std::string loopback = test::enter_private_loopback(8);
+  cli::Args args("mocap-bench-rig-live [options]",
+                 "Fake GigE cameras joined by capture time for minutes; one killed and restarted.");
+  args.option("seconds", "S", "run length", "300", cli::Range::at_least(12))
+      .option("cameras", "N", "fake cameras (2..8)", "4", cli::Range::count(2, 8))
+      .option("fps", "F", "frame rate of every camera", "30", cli::Range::between(1, 120))
+      .option("tolerance-ms", "MS", "sync_tolerance_ms", "10", cli::Range::positive())
+      .option("wait-ms", "MS", "sync_wait_ms", "200", cli::Range::positive())
+      .option("size", "WxH", "frame size", "320x240", cli::Range::image_size());
+  int code = 0;
+  if (!args.parse(argc - 1, argv + 1, code)) return code;
+  if (!loopback.empty()) {
+    std::cerr << "mocap-bench-rig-live: " << loopback << "\n";
+    return 1;
+  }
+  const auto program = test::fake_camera_program();
+  if (!program) {
+    std::cerr << "mocap-bench-rig-live: " << test::kFakeCameraProgram
+              << " not on PATH (package aravis-tools)\n";
+    return 1;
+  }
+  Settings s;
+  s.cameras = static_cast<int>(args.integer("cameras"));
+  s.fps = args.number("fps");
+  s.tolerance_ms = args.number("tolerance-ms");
+  s.wait_ms = args.number("wait-ms");
+  s.width = args.image_size("size").width;
+  s.height = args.image_size("size").height;
+  const double seconds = args.number("seconds");
+
+  std::vector<std::string> serials;
+  std::vector<std::unique_ptr<test::FakeGvCamera>> cameras;
+  const auto address = [](int i) { return "127.0.0." + std::to_string(i + 1); };
+  for (int i = 0; i < s.cameras; ++i) {
+    serials.push_back("BENCH" + std::to_string(i + 1));
+    cameras.push_back(
+        std::make_unique<test::FakeGvCamera>(*program, serials.back(), 0, 15s, address(i)));
+  }
+  graph::Runtime runtime(
+      graph::resolve(graph::parse_graph_text(graph_text(s, serials), "rig_live_bench")));
+  graph::RunResult result;
+  const auto start = Clock::now();
+  std::thread run([&] { result = runtime.run(); });
+  const auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - start).count(); };
+
+  std::printf(
+      "%d fake cameras at %g fps (%dx%d Mono8), sync_tolerance_ms %g, sync_wait_ms %g, "
+      "%g s; cam%d killed at %.0f s, restarted at %.0f s\n\n",
+      s.cameras, s.fps, s.width, s.height, s.tolerance_ms, s.wait_ms, seconds, s.cameras,
+      seconds / 3, seconds / 2);
+  print_header(s.cameras);
+  std::vector<Sample> samples;
+  const std::string watched = "cam" + std::to_string(s.cameras);
+  const double kill_at = seconds / 3, restart_at = seconds / 2, step = seconds / 10;
+  bool killed = false, restarted = false;
+  double next_sample = 5;  // after warm-up
+  while (elapsed() < seconds) {
+    std::this_thread::sleep_for(100ms);
+    const double t = elapsed();
+    std::string event;
+    if (!killed && t >= kill_at) {
+      samples.push_back(sample(runtime, t, "before kill", watched));
+      print_row(samples.back());
+      cameras.back()->stop();
+      killed = true;
+      event = "cam" + std::to_string(s.cameras) + " killed";
+    } else if (!restarted && t >= restart_at) {
+      samples.push_back(sample(runtime, t, "before restart", watched));
+      print_row(samples.back());
+      cameras.back() = std::make_unique<test::FakeGvCamera>(*program, serials.back(), 0, 15s,
+                                                            address(s.cameras - 1));
+      restarted = true;
+      event = "cam" + std::to_string(s.cameras) + " restarted";
+    } else if (t < next_sample) {
+      continue;
+    }
+    samples.push_back(sample(runtime, elapsed(), event, watched));
+    print_row(samples.back());
+    while (next_sample <= t) next_sample += step;
+  }
+  samples.push_back(sample(runtime, elapsed(), "end", watched));
+  print_row(samples.back());
+  runtime.request_stop();
+  run.join();
+
+  // The verdict.
+  const Sample& warm = samples.front();
+  const Sample& end = samples.back();
+  const auto find = [&](const std::string& event) {
+    return *std::find_if(samples.begin(), samples.end(),
+                         [&](const Sample& x) { return x.event == event; });
+  };
+  const Sample before_kill = find("before kill"), before_restart = find("before restart");
+  const std::size_t lost = static_cast<std::size_t>(s.cameras - 1);
+  const auto missing = [&](const Sample& x) { return x.sync.inputs.at(lost).missing; };
+  const auto received = [&](const Sample& x, std::size_t i) {
+    return x.sync.inputs.at(i).received;
+  };
+  const double away_s = before_restart.t - before_kill.t;
+  std::printf("\nwhile cam%d was away (%.0f s): %llu sets without it (%.1f per s); ", s.cameras,
+              away_s,
+              static_cast<unsigned long long>(missing(before_restart) - missing(before_kill)),
+              static_cast<double>(missing(before_restart) - missing(before_kill)) / away_s);
+  std::printf(
+      "the others received %llu frames (%.1f per s each)\n",
+      static_cast<unsigned long long>(received(before_restart, 0) - received(before_kill, 0)),
+      static_cast<double>(received(before_restart, 0) - received(before_kill, 0)) / away_s);
+  std::printf("cam%d after its restart: %llu frames received; its status: %s\n", s.cameras,
+              static_cast<unsigned long long>(received(end, lost) - received(before_restart, lost)),
+              end.last_status.c_str());
+  // The cameras start one after the other: the first sets are partial until all stream.
+  const auto share = [](const Sample& a, const Sample& b, const char* what) {
+    const auto sets = b.sync.sets - a.sync.sets, complete = b.sync.complete - a.sync.complete;
+    std::printf("%s (%.0f..%.0f s): %llu sets, %llu complete (%.1f %%)\n", what, a.t, b.t,
+                static_cast<unsigned long long>(sets), static_cast<unsigned long long>(complete),
+                100.0 * static_cast<double>(complete) /
+                    static_cast<double>(std::max<std::uint64_t>(sets, 1)));
+  };
+  share(warm, before_kill, "all cameras, after warm-up");
+  const auto back = std::find_if(samples.begin(), samples.end(), [&](const Sample& x) {
+    return x.t >= before_restart.t + 10;  // reconnected by then
+  });
+  if (back != samples.end()) share(*back, end, "all cameras again, after the restart");
+  std::printf("memory: %.1f MiB after warm-up, %.1f MiB at the middle, %.1f MiB at the end\n",
+              warm.rss, samples[samples.size() / 2].rss, end.rss);
+  std::printf("sets: %llu, complete %llu (%.1f %%), late %llu, restarts %llu; run %s\n",
+              static_cast<unsigned long long>(end.sync.sets),
+              static_cast<unsigned long long>(end.sync.complete),
+              100.0 * static_cast<double>(end.sync.complete) /
+                  static_cast<double>(std::max<std::uint64_t>(end.sync.sets, 1)),
+              static_cast<unsigned long long>([&] {
+                std::uint64_t late = 0;
+                for (const auto& i : end.sync.inputs) late += i.late;
+                return late;
+              }()),
+              static_cast<unsigned long long>(end.sync.restarts),
+              result.ok ? "ok" : result.error.c_str());
+  std::cout << graph::format_sync_stats(end.sync) << "\n";
+  return result.ok ? 0 : 1;
+}
