@@ -12,17 +12,14 @@
 
 #include "camera/camera.hpp"
 #include "camera/rig_file.hpp"
-#include "eval/multiview_scene.hpp"
+#include "eval/offset_scene.hpp"
 #include "io/openpose_json.hpp"
 #include "support/shared_data.hpp"
 
 namespace mocap::camera {
 namespace {
 
-struct Views {
-  std::vector<Camera> cameras;
-  std::vector<BodySequence> views;
-};
+using Views = eval::ShiftedViews;
 
 // `frames` frames per view of one runner (09_12, train) seen by a ring of 3 cameras, the scene
 // read at `steps` x 30 frames/s: view v's frame i is scene step (i + starts[v]) * steps +
@@ -36,39 +33,12 @@ Views runner_views(const std::vector<int>& starts, const std::vector<int>& phase
   }
   eval::ScenePerson person;
   person.motion = &truth[steps].front();
-  Views out;
-  const auto ring = eval::ring_rig(3, 5.0, 1.6, 0.5, {0.0, 1.0, 0.0}, eval::Image{});
-  for (const eval::SceneCamera& c : ring) {
-    Camera& camera = out.cameras.emplace_back();
-    camera.width = c.width;
-    camera.height = c.height;
-    camera.fx = c.K[0][0];
-    camera.fy = c.K[1][1];
-    camera.cx = c.K[2][0];
-    camera.cy = c.K[2][1];
-    camera.rotation = c.R;
-    camera.translation = c.t;
-  }
-  eval::SceneRenderer renderer(ring, 7);
   eval::SceneDegradation degradation;
   degradation.noise = noise;
   degradation.dropout = 0.10f;
   degradation.occlusion = false;
-  out.views.resize(starts.size());
-  for (std::size_t v = 0; v < starts.size(); ++v) {
-    for (int i = 0; i < frames; ++i) {
-      const int step = (i + starts[v]) * steps + phases[v];
-      const eval::SceneFrame f = renderer.render({person}, step, degradation);
-      std::vector<BodyKeypoints> frame;
-      for (const eval::SceneDetection& d : f.views[v]) {
-        BodyKeypoints& b = frame.emplace_back();
-        for (int k = 0; k < kBodyJoints; ++k)
-          b[k] = {d.xyc[3 * k], d.xyc[3 * k + 1], d.xyc[3 * k + 2]};
-      }
-      out.views[v].push_back(std::move(frame));
-    }
-  }
-  return out;
+  return eval::shifted_views(person, eval::ring_rig(3, 5.0, 1.6, 0.5, {0.0, 1.0, 0.0}, {}), starts,
+                             phases, steps, frames, degradation, 7);
 }
 
 TEST(FrameOffsets, ViewsThatStartLateOrEarlyAreFound) {

@@ -628,11 +628,6 @@ int reconstruct_command(int argc, char** argv) {
   const ReconstructRun run = run_reconstruct_graph(resolved, options, progress, bar, earlier, out,
                                                    args.has("quiet"), started);
   if (run.nothing_written) return *run.nothing_written;
-  const graph::RunResult& result = run.result;
-  const double seconds = run.seconds;
-  const std::vector<fs::path>& files = run.files;
-  const WrittenOutputs& written = run.written;
-  const std::string& outcome = run.outcome;
   json summary = summarize_output(out / "poses.jsonl");
   summary["input"] = input;
   summary["database"] = args.get("db");
@@ -645,25 +640,33 @@ int reconstruct_command(int argc, char** argv) {
     summary["video"] = {
         {"width", info.width}, {"height", info.height}, {"fps", info.fps}, {"frames", info.frames}};
   }
-  summary["seconds"] = seconds;
-  const double frames_per_second = seconds > 0 ? summary["frames"].get<double>() / seconds : 0.0;
-  summary["frames_per_second"] = frames_per_second;
   summary["id_switches"] =
       nullptr;  // needs ground-truth identities: see `mocap eval` and the tracker tests
+  return finish_reconstruct(run, summary, out, info.frames);
+}
+
+int finish_reconstruct(const ReconstructRun& run, json& summary, const fs::path& out,
+                       std::int64_t input_frames) {
+  const graph::RunResult& result = run.result;
+  summary["seconds"] = run.seconds;
+  const double frames_per_second =
+      run.seconds > 0 ? summary["frames"].get<double>() / run.seconds : 0.0;
+  summary["frames_per_second"] = frames_per_second;
   summary["nodes"] = node_latency(result.stats);
   summary["completed"] = result.ok && !result.stopped;
   summary["interrupted"] = result.stopped;
   if (!result.ok) summary["error"] = result.error;
-  summary["files"] = files_json(files);
+  summary["files"] = files_json(run.files);
   summary["git_commit"] = git_commit();
   const fs::path summary_file = out / "summary.json";
   write_file_atomically(summary_file, json_text(summary, 2) + "\n");
 
-  print_written(out, written, summary, frames_per_second);
+  print_written(out, run.written, summary, frames_per_second);
   std::cout << "wrote " << summary_file.string() << "\n";
-  if (!outcome.empty()) {
-    std::cerr << "mocap reconstruct: " << outcome << "\n"
-              << "mocap reconstruct: " << incomplete_note(written, summary, info.frames) << "\n";
+  if (!run.outcome.empty()) {
+    std::cerr << "mocap reconstruct: " << run.outcome << "\n"
+              << "mocap reconstruct: " << incomplete_note(run.written, summary, input_frames)
+              << "\n";
   }
   if (!result.ok) return 1;
   return result.stopped ? 130 : 0;

@@ -13,6 +13,7 @@
 #include <cmath>
 #include <filesystem>
 #include <iostream>
+#include <optional>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
@@ -33,6 +34,7 @@
 #include "progress_bar.hpp"
 #include "reconstruct_report.hpp"
 #include "video/video_source.hpp"
+#include "view_offsets.hpp"
 
 namespace mocap::cli {
 namespace {
@@ -47,7 +49,9 @@ struct View {
   ViewKind kind = ViewKind::openpose_json;
   const camera::Camera* camera = nullptr;
   std::int64_t frames = -1;
-  double fps = 0.0;  // videos: their own rate
+  double fps = 0.0;                             // videos: their own rate
+  std::int64_t frame_offset = 0;                // added to the view's frame numbers (--offsets)
+  std::optional<camera::ViewOffset> estimated;  // --offsets auto
 };
 
 ViewKind view_kind(const std::string& path) {
@@ -133,8 +137,12 @@ std::vector<View> match_views(const camera::Rig& rig, const std::vector<std::str
                                                     " views were given");
   }
   std::vector<View> views;
-  for (std::size_t i = 0; i < paths.size(); ++i)
-    views.push_back({paths[i], view_kind(paths[i]), &rig.cameras[i]});
+  for (std::size_t i = 0; i < paths.size(); ++i) {
+    View& v = views.emplace_back();
+    v.path = paths[i];
+    v.kind = view_kind(paths[i]);
+    v.camera = &rig.cameras[i];
+  }
   return views;
 }
 
@@ -152,11 +160,13 @@ std::string graph_text(const std::vector<View>& views, const std::string& rig_fi
     const std::string camera = quoted(v.camera->name);
     if (v.kind == ViewKind::openpose_json) {
       g << "  view_" << i << ": { type: source.openpose_json, params: { path: " << quoted(v.path)
-        << ", fps: " << rate << ", camera: " << camera << " } }\n";
+        << ", fps: " << rate << ", camera: " << camera << ", frame_offset: " << v.frame_offset
+        << " } }\n";
       continue;
     }
     g << "  view_" << i << ": { type: source.video, params: { path: " << quoted(v.path)
-      << ", mode: offline, fps: " << rate << ", camera: " << camera << " } }\n";
+      << ", mode: offline, fps: " << rate << ", camera: " << camera
+      << ", frame_offset: " << v.frame_offset << " } }\n";
     const DetectorPreset& preset = detector_preset(detector);
     g << "  detect_" << i << ": { type: " << preset.type << ", params: {";
     for (std::size_t p = 0; p < preset.params.size(); ++p)
@@ -181,6 +191,70 @@ std::string graph_text(const std::vector<View>& views, const std::string& rig_fi
   }
   g << "  - [solve.out, jsonl.in]\n  - [solve.out, bvh.in]\n  - [solve.out, trc.in]\n";
   return g.str();
+}
+
+// --offsets: per view the frames its numbering is moved by (its frame i shows the first view's
+// frame i + offset), given as numbers or estimated from the keypoints of JSON views (auto).
+// Estimates keep their fraction in the summary; the views are moved by whole frames, shifted so
+// that the earliest view starts at frame 0.
+void apply_offsets(std::vector<View>& views, const camera::Rig& rig, const std::string& given) {
+  std::vector<double> offsets;
+  if (given == "auto") {
+    std::vector<std::string> folders;
+    for (const View& v : views) {
+      if (v.kind != ViewKind::openpose_json)
+        throw InputError("--offsets", "auto needs keypoints: " + v.path +
+                                          " is not an OpenPose JSON folder; give the offsets "
+                                          "as numbers (e.g. --offsets 0,3,-2)");
+      folders.push_back(v.path);
+    }
+    io::OpenPoseOptions keypoints;  // as source.openpose_json reads them (layout auto)
+    keypoints.body25 = io::Body25Choice::detect;
+    const ViewOffsets estimated = estimate_view_offsets(
+        rig, folders, keypoints, 0, camera::OffsetOptions{}, "mocap reconstruct");
+    for (std::size_t i = 0; i < views.size(); ++i) {
+      const camera::ViewOffset& o = estimated.offsets[i];
+      if (i > 0 && !o.found)
+        throw InputError(views[i].camera->name,
+                         "no frame offset found for " + views[i].path + ": " + o.problem +
+                             "; give the offsets as numbers (--offsets 0,N,...)");
+      views[i].estimated = o;
+      offsets.push_back(o.frames);
+      if (i > 0)
+        std::cerr << "mocap reconstruct: " << views[i].camera->name << " (" << views[i].path
+                  << ") starts " << o.frames << " frames after " << views[0].camera->name
+                  << " (contrast " << o.contrast << ")\n";
+    }
+  } else {
+    std::stringstream list(given);
+    for (std::string item; std::getline(list, item, ',');) {
+      char* end = nullptr;
+      const double value = std::strtod(item.c_str(), &end);
+      if (item.empty() || *end != '\0' || !std::isfinite(value) || std::abs(value) > 1e6)
+        throw InputError("--offsets", "'" + item + "' is not a number of frames");
+      offsets.push_back(value);
+    }
+    if (offsets.size() != views.size())
+      throw InputError("--offsets", std::to_string(offsets.size()) + " offsets for " +
+                                        std::to_string(views.size()) +
+                                        " views: give one per view (the first is usually 0) or "
+                                        "auto");
+  }
+  std::int64_t earliest = 0;
+  for (std::size_t i = 0; i < views.size(); ++i) {
+    views[i].frame_offset = std::llround(offsets[i]);
+    earliest = std::min(earliest, views[i].frame_offset);
+  }
+  for (View& v : views) v.frame_offset -= earliest;
+}
+
+json offsets_json(const View& v) {
+  json o = {{"applied_frames", v.frame_offset}};
+  if (v.estimated) {
+    o["estimated_frames"] = v.estimated->frames;
+    o["contrast"] = v.estimated->contrast;
+  }
+  return o;
 }
 
 }  // namespace
@@ -222,6 +296,11 @@ int reconstruct_multiview_command(int argc, char** argv) {
       .option("detector", "NAME",
               "videos and image folders: how people are found, one of " + detector_names(),
               std::string(kFileDetector))
+      .option("offsets", "auto|N,N,...",
+              "views filmed without a common clock: per view the frames it is shifted by (its "
+              "frame i shows the first view's frame i + N), or auto: estimated from the people "
+              "in OpenPose JSON views (docs/cameras.md, \"Frame offsets\"); applied to the "
+              "nearest frame")
       .option("set", "NODE.PARAM=VALUE",
               "override a node parameter of the graph (e.g. solve.volume=x0,y0,z0,x1,y1,z1)",
               std::nullopt, true)
@@ -254,6 +333,7 @@ int reconstruct_multiview_command(int argc, char** argv) {
     frames = std::max(frames, v.frames);
   }
   if (fps <= 0.0) fps = 30.0;
+  if (args.has("offsets")) apply_offsets(views, rig, args.get("offsets"));
   std::string floor_how;
   const GroundPlane floor = multiview::rig_floor(rig, &floor_how);
   // TRC files are Y-up (OpenSim): a world whose floor is level in x-y (Pose2Sim's, a board's) is
@@ -283,11 +363,6 @@ int reconstruct_multiview_command(int argc, char** argv) {
   const ReconstructRun run = run_reconstruct_graph(resolved, options, progress, bar, earlier, out,
                                                    args.has("quiet"), started);
   if (run.nothing_written) return *run.nothing_written;
-  const graph::RunResult& result = run.result;
-  const double seconds = run.seconds;
-  const std::vector<fs::path>& files = run.files;
-  const WrittenOutputs& written = run.written;
-  const std::string& outcome = run.outcome;
   json summary = summarize_output(out / "poses.jsonl");
   summary["calibration"] = rig_file;
   json view_list = json::array();
@@ -295,31 +370,13 @@ int reconstruct_multiview_command(int argc, char** argv) {
     view_list.push_back({{"camera", v.camera->name},
                          {"path", v.path},
                          {"kind", v.kind == ViewKind::video ? "video" : "openpose_json"},
-                         {"frames", v.frames}});
+                         {"frames", v.frames},
+                         {"offset", offsets_json(v)}});
   }
   summary["views"] = view_list;
   summary["fps"] = fps;
   summary["floor"] = floor_how;
-  summary["seconds"] = seconds;
-  const double frames_per_second = seconds > 0 ? summary["frames"].get<double>() / seconds : 0.0;
-  summary["frames_per_second"] = frames_per_second;
-  summary["nodes"] = node_latency(result.stats);
-  summary["completed"] = result.ok && !result.stopped;
-  summary["interrupted"] = result.stopped;
-  if (!result.ok) summary["error"] = result.error;
-  summary["files"] = files_json(files);
-  summary["git_commit"] = git_commit();
-  const fs::path summary_file = out / "summary.json";
-  write_file_atomically(summary_file, json_text(summary, 2) + "\n");
-
-  print_written(out, written, summary, frames_per_second);
-  std::cout << "wrote " << summary_file.string() << "\n";
-  if (!outcome.empty()) {
-    std::cerr << "mocap reconstruct: " << outcome << "\n"
-              << "mocap reconstruct: " << incomplete_note(written, summary, frames) << "\n";
-  }
-  if (!result.ok) return 1;
-  return result.stopped ? 130 : 0;
+  return finish_reconstruct(run, summary, out, frames);
 }
 
 }  // namespace mocap::cli

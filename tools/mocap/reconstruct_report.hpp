@@ -51,6 +51,13 @@ ReconstructRun run_reconstruct_graph(const graph::ResolvedGraph& graph,
                                      EarlierOutput& earlier, const std::filesystem::path& out,
                                      bool quiet, std::chrono::steady_clock::time_point started);
 
+// The end of a run that wrote something: `summary` (the command's own fields already in) gains
+// the run's time, rate, node statistics, outcome and files and is written as out/summary.json;
+// the files are listed, an incomplete run says what it kept. Returns the exit code (0, 1 failed,
+// 130 interrupted).
+int finish_reconstruct(const ReconstructRun& run, nlohmann::json& summary,
+                       const std::filesystem::path& out, std::int64_t input_frames);
+
 // Per node: in, out, drops, latency.
 nlohmann::json node_latency(const graph::GraphStats& stats);
 

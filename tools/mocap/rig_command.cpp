@@ -12,6 +12,7 @@
 #include "commands.hpp"
 #include "core/input_error.hpp"
 #include "io/openpose_json.hpp"
+#include "view_offsets.hpp"
 
 namespace mocap::cli {
 namespace {
@@ -92,16 +93,11 @@ int offsets(int argc, char** argv) {
   json_options.body25 = layout == "auto"       ? io::Body25Choice::detect
                         : layout == "BODY_25B" ? io::Body25Choice::body25b
                                                : io::Body25Choice::body25;
-  std::vector<camera::BodySequence> views;
-  for (std::size_t v = 0; v < folders.size(); ++v) {
-    const io::OpenPoseSequence json = io::read_openpose_folder(folders[v], json_options);
-    for (const io::FrameProblem& p : json.problems)
-      std::cerr << "mocap rig offsets: " << folders[v] << ": " << p.message << "\n";
-    views.push_back(camera::body_sequence(json.frames));
-  }
   camera::OffsetOptions options;
   options.max_offset_frames = static_cast<int>(args.integer("max-offset"));
-  const auto found = camera::estimate_offsets(rig.cameras, views, reference, options);
+  const ViewOffsets estimated =
+      estimate_view_offsets(rig, folders, json_options, reference, options, "mocap rig offsets");
+  const std::vector<camera::ViewOffset>& found = estimated.offsets;
   std::cout
       << "| view | camera | frames | offset (frames) | contrast | epipolar cost (body heights) |\n"
          "|---|---|---|---|---|---|\n";
@@ -111,7 +107,7 @@ int offsets(int argc, char** argv) {
     if (v != reference) std::snprintf(offset, sizeof offset, "%+.2f", found[v].frames);
     char row[256];
     std::snprintf(row, sizeof row, "| %zu | %s | %zu | %s%s | %.2f | %.4f |\n", v + 1,
-                  rig.cameras[v].name.c_str(), views[v].size(), offset,
+                  rig.cameras[v].name.c_str(), estimated.frames[v], offset,
                   found[v].found ? "" : " (none)", found[v].contrast, found[v].cost);
     std::cout << row;
     if (!found[v].found) ++missing;

@@ -25,6 +25,11 @@ class OpenPoseJsonSource : public Node {
     c.param<std::string>("camera", std::string(kDefaultCamera),
                          "the name of the camera the keypoints were detected in (as in the rig "
                          "file, docs/cameras.md)");
+    c.param<std::int64_t>("frame_offset", 0,
+                          "added to every frame number (and time): this view's frame i is the "
+                          "scene's frame i + frame_offset (views filmed without a common clock, "
+                          "`mocap rig offsets`)",
+                          {-1e6, 1e6});
   }
 
   void open(Context& ctx) override {
@@ -39,6 +44,7 @@ class OpenPoseJsonSource : public Node {
     fps_ = ctx.param<double>("fps");
     stream_ = ctx.param<std::string>("stream");
     camera_ = ctx.param<std::string>("camera");
+    offset_ = ctx.param<std::int64_t>("frame_offset");
     if (stream_.empty()) stream_ = ctx.param<std::string>("path");
     std::cerr << ctx.node_name() << ": " << sequence_.frames.size() << " frames, layout "
               << layout_name(sequence_.layout) << ", " << sequence_.problems.size()
@@ -55,9 +61,9 @@ class OpenPoseJsonSource : public Node {
     frame.camera = camera_;
     frame.header.stream = stream_;
     frame.header.seq = next_;
-    frame.header.frame = static_cast<std::int64_t>(next_);
-    frame.header.capture_ns =
-        static_cast<std::int64_t>(std::llround(1e9 * static_cast<double>(next_) / fps_));
+    frame.header.frame = static_cast<std::int64_t>(next_) + offset_;
+    frame.header.capture_ns = static_cast<std::int64_t>(
+        std::llround(1e9 * static_cast<double>(frame.header.frame) / fps_));
     ++next_;
     ctx.send("out", std::move(frame));
   }
@@ -67,6 +73,7 @@ class OpenPoseJsonSource : public Node {
   io::OpenPoseSequence sequence_;
   std::size_t next_ = 0;
   double fps_ = 30.0;
+  std::int64_t offset_ = 0;
   std::string stream_;
   std::string camera_;
 };

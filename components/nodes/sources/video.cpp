@@ -6,6 +6,7 @@
 // A file, or a file served over HTTP/RTSP, that stops well before the frames its container
 // announces stops the graph with an error naming the input (the run ends incomplete, exit 1).
 
+#include <cmath>
 #include <iostream>
 #include <optional>
 
@@ -37,6 +38,10 @@ class VideoSourceNode : public Node {
     c.param<std::string>("camera", std::string(kDefaultCamera),
                          "the camera's name in the messages (as in the rig file, docs/cameras.md)");
     c.param<std::string>("stream", "", "stream id of the messages (default: the path)");
+    c.param<std::int64_t>("frame_offset", 0,
+                          "files: added to every frame number and time (this view's frame i is "
+                          "the scene's frame i + frame_offset: views without a common clock)",
+                          {-1e6, 1e6});
     c.param<bool>("loop", false, "files and folders: start again at the end (counts the passes)");
   }
 
@@ -55,6 +60,7 @@ class VideoSourceNode : public Node {
     playback_.emplace(path, options, playback);
     count_ = ctx.param<std::uint64_t>("count");
     camera_ = ctx.param<std::string>("camera");
+    offset_ = ctx.param<std::int64_t>("frame_offset");
     stream_ = ctx.param<std::string>("stream");
     if (stream_.empty()) stream_ = path;
     std::cerr << ctx.node_name() << ": " << playback_->describe() << "\n";
@@ -71,7 +77,9 @@ class VideoSourceNode : public Node {
       return;
     }
     VideoFrame message;
-    message.header = {stream_, sent_, frame->stamp_ns, frame->frame.index};
+    message.header = {stream_, sent_, frame->stamp_ns, frame->frame.index + offset_};
+    if (offset_ != 0 && playback_->source().fps() > 0)
+      message.header.capture_ns += std::llround(1e9 * offset_ / playback_->source().fps());
     message.camera = camera_;
     message.image = std::move(frame->frame.image);
     ctx.send("frames", std::move(message));
@@ -111,6 +119,7 @@ class VideoSourceNode : public Node {
   std::optional<video::Playback> playback_;
   std::uint64_t count_ = 0, sent_ = 0, late_ = 0, undecodable_ = 0, passes_ = 0;
   std::string camera_;
+  std::int64_t offset_ = 0;
   std::string stream_;
 };
 
