@@ -120,14 +120,20 @@ std::vector<HumanEvaSequence> humaneva_validation_sequences(const he::Dataset& d
   return out;
 }
 
+std::vector<recon::BodyXyc> noisy_input(const HumanEvaSequence& sequence,
+                                        const Condition& condition, std::uint64_t seed) {
+  std::vector<recon::BodyXyc> input = sequence.input;
+  InputNoise noise(seed);
+  for (recon::BodyXyc& frame : input) noise.apply(condition, frame);
+  return input;
+}
+
 Scores evaluate_sequence(recon::Matcher& matcher, const recon::FrameBones& bones,
                          const HumanEvaSequence& sequence, const Condition& condition,
                          const recon::SequenceOptions& options, std::uint64_t seed,
                          const recon::LayoutOffsets* map_back, Scores* mapped) {
-  std::vector<recon::BodyXyc> input = sequence.input;
-  InputNoise noise(seed);
-  for (recon::BodyXyc& frame : input) noise.apply(condition, frame);
-  auto poses = recon::reconstruct_sequence(matcher, bones, input, options);
+  auto poses =
+      recon::reconstruct_sequence(matcher, bones, noisy_input(sequence, condition, seed), options);
   const Scores canonical = score(poses, sequence.truth_camera);
   if (map_back && mapped) {
     for (recon::Pose3D& pose : poses)

@@ -72,7 +72,14 @@ std::vector<HumanEvaSequence> humaneva_validation_sequences(
     const io::humaneva::Dataset& dataset, const HumanEvaCameras& cameras, double fps,
     io::humaneva::Split split = io::humaneva::Split::validate);
 
-// Adds the condition's noise to the input, reconstructs it and scores it against the truth.
+// The sequence's 2D input with the condition's noise, from the random stream `seed` starts:
+// what evaluate_sequence reconstructs, and what the multi-view protocol (humaneva_multiview.hpp)
+// gives each camera, so both see the same 2D.
+std::vector<recon::BodyXyc> noisy_input(const HumanEvaSequence& sequence,
+                                        const Condition& condition, std::uint64_t seed);
+
+// Adds the condition's noise to the input (noisy_input), reconstructs it and scores it against
+// the truth.
 // With `map_back` and `mapped`, the reconstruction is also scored after moving its canonical
 // joints to where the layout puts them (recon::apply_layout_offsets_3d, direction -1): the
 // truth is in HumanEva-15's own definition (thorax, pelvis, headDistal), not the canonical one.

@@ -8,16 +8,11 @@
 // non-finite coordinate) is three empty cells. Tab-separated, '\n' line ends.
 //
 // TrcStreamWriter keeps the file valid on disk after every frame, also when the process is killed
-// at any moment (the scheme of motion/bvh_stream_writer.hpp):
-// - the header is written to PATH.part, which is renamed to PATH: PATH never exists without its
-//   whole header (an existing PATH is replaced at once);
-// - each row is one write() of one line, then the header's values line (line 3, which holds the
-//   counts in fixed-width fields) is rewritten in place by one pwrite();
-// - a row never crosses a 4 KiB page boundary (spaces at the start of the row pad it to the next
-//   page when it would), nor does the header, because the kernel can stop a write killed by a
-//   signal between two pages but not inside one.
-// So a killed writer leaves its counted rows, possibly followed by the one row written before its
-// count was raised, whole, or by spaces; io::parse_trc ignores such a last uncounted row.
+// at any moment: a GrowingFile (core/growing_file.hpp) whose header is written to PATH.part
+// renamed to PATH (PATH never exists without its whole header; an existing PATH is replaced at
+// once), one row per frame, the header's values line (line 3, the counts in fixed-width fields)
+// rewritten in place after each. A killed writer leaves its counted rows, possibly followed by
+// one whole uncounted row or spaces; io::parse_trc ignores such a last uncounted row.
 
 #include <cstdint>
 #include <span>
@@ -25,6 +20,8 @@
 #include <vector>
 
 #include <glm/vec3.hpp>
+
+#include "core/growing_file.hpp"
 
 namespace mocap::io {
 
@@ -44,38 +41,33 @@ class TrcStreamWriter {
   // Writes the header (NumFrames 0) and makes PATH. Throws InputError naming the file when it
   // cannot, std::invalid_argument on no markers, a rate that is not positive or a first frame < 1.
   TrcStreamWriter(std::string path, TrcLayout layout);
-  TrcStreamWriter(TrcStreamWriter&& other) noexcept;
-  TrcStreamWriter& operator=(TrcStreamWriter&& other) noexcept;
+  TrcStreamWriter(TrcStreamWriter&& other) noexcept = default;
+  TrcStreamWriter& operator=(TrcStreamWriter&& other) noexcept = default;
   TrcStreamWriter(const TrcStreamWriter&) = delete;
   TrcStreamWriter& operator=(const TrcStreamWriter&) = delete;
-  ~TrcStreamWriter();  // closes without throwing: call close() to learn about a failure
+  ~TrcStreamWriter() = default;  // closes without throwing: call close() to learn about a failure
 
   // Appends the next frame (one position per marker; non-finite: missing) and raises the counts.
   // Throws InputError naming the file on a write error (the file is cut back to its counted rows)
   // and std::invalid_argument on a wrong marker count.
   void append(std::span<const glm::vec3> markers);
   // Flushes to the disk and closes; idempotent. Throws InputError naming the file on failure.
-  void close();
+  void close() { file_.close(); }
   // Closes the file descriptor, keeping the state; the next append() reopens the file (a sink
   // with many people stays under the open-file limit). Throws InputError when the file changed.
-  void suspend();
+  void suspend() { file_.suspend(); }
 
-  const std::string& path() const { return path_; }
+  const std::string& path() const { return file_.path(); }
   std::int64_t frame_count() const { return frames_; }
-  bool is_open() const { return fd_ >= 0; }
+  bool is_open() const { return file_.is_open(); }
 
  private:
-  void write_at(std::int64_t offset, std::string_view bytes);
-  void write_counts();
-  void resume();
-  void release() noexcept;
+  static std::string header(const TrcLayout& layout, const std::string& path,
+                            std::int64_t& values_offset);
 
-  std::string path_;
   TrcLayout layout_;
-  int fd_ = -1;
-  bool suspended_ = false;
   std::int64_t values_offset_ = 0;  // where header line 3 starts
-  std::int64_t end_ = 0;            // file size after the last counted row
+  GrowingFile file_;
   std::int64_t frames_ = 0;
   std::string row_;  // reused for each row's text
 };

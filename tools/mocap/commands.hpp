@@ -13,6 +13,8 @@ int humaneva_eval_command(int argc, char** argv);
 // `mocap eval humaneva-fit` and `mocap eval crossview`, reached through eval_command.
 int humaneva_fit_command(int argc, char** argv);
 int crossview_eval_command(int argc, char** argv);
+// `mocap eval humaneva-multiview` (issue 19 report 3).
+int humaneva_multiview_command(int argc, char** argv);
 // `mocap eval multiview` and `mocap eval pose2sim` (issue 19 reports 2 and 1).
 int multiview_eval_command(int argc, char** argv);
 int pose2sim_eval_command(int argc, char** argv);

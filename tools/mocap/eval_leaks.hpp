@@ -1,8 +1,9 @@
 #pragma once
 // An evaluation must not score a database on motion it was built from (../shared/docs/
-// EVALUATION.md): `mocap eval virtual` runs on the held-out CMU subjects, `mocap eval humaneva` and
-// `humaneva-fit` on a HumanEva split. A database holding any of that motion is refused, naming the
-// clips, or with --allow-leak evaluated anyway with a loud warning, recorded in the results.
+// EVALUATION.md): `mocap eval virtual` runs on the held-out CMU subjects, `mocap eval humaneva`,
+// `humaneva-fit` and `humaneva-multiview` on a HumanEva split. A database holding any of that
+// motion is refused, naming the clips, or with --allow-leak evaluated anyway with a loud warning,
+// recorded in the results.
 
 #include <string>
 #include <string_view>
