@@ -6,8 +6,8 @@
 //   (i)   the baseline: confidence-weighted DLT with Pose2Sim's camera-exclusion rule, per frame;
 //   (ii)  ours per frame (association + robust triangulation, no tracking);
 //   (iii) ours with tracking in 3D;
-//   (iv)  + skeleton fit: not measured here yet (the multi-view fit lives in components/fit; the
-//         table says "n/a" until it can be called, see MultiviewMethod).
+//   (iv)  + skeleton fit on all views over (iii)'s tracks (fit::fit_tracks with
+//         fit::multiview_fit_defaults(), weights chosen on train scenes), full and live.
 // and scored in the world frame: MPJPE (no alignment), PA-MPJPE, acceleration error, bone-length
 // standard deviation, wrong associations, id switches, coverage.
 //
@@ -25,10 +25,9 @@
 
 namespace mocap::eval {
 
-enum class MultiviewMethod { pose2sim_rule, per_frame, tracking, skeleton_fit };
+enum class MultiviewMethod { pose2sim_rule, per_frame, tracking, skeleton_fit, skeleton_fit_live };
 std::string_view method_label(MultiviewMethod method);
-// Whether this build can run it (skeleton_fit: not yet).
-bool method_available(MultiviewMethod method);
+bool fits_skeleton(MultiviewMethod method);  // skeleton_fit or skeleton_fit_live
 
 struct MultiviewCase {
   int views = 4;
@@ -52,14 +51,13 @@ struct MultiviewProtocolOptions {
 struct MultiviewResult {
   MultiviewCase scene;
   MultiviewMethod method = MultiviewMethod::tracking;
-  bool available = true;
   long frames = 0;  // frame sets evaluated
   SceneScore score;
   double pa_mpjpe_mm = 0.0;        // per person-frame similarity alignment, mean over joints
   double accel_error_mm = 0.0;     // mm/frame², joints reconstructed in three consecutive frames
   double bone_std_mm = 0.0;        // std of each of the 14 bones' length per person, mean
   double truth_bone_std_mm = 0.0;  // the same of the truth in the frames scored (rigid: ~0)
-  double cpu_s = 0.0;              // reconstruction only
+  double cpu_s = 0.0;              // reconstruction (+ fit for (iv))
   double wrong_association_share() const {
     return score.person_frames > 0
                ? static_cast<double>(score.wrong_associations) / score.person_frames
@@ -70,7 +68,7 @@ struct MultiviewResult {
 // The held-out clips of a cmu31 folder (splits.txt), at `fps`. Throws InputError naming the folder.
 std::vector<TruthSequence> load_heldout_clips(const std::string& cmu_folder, double fps);
 
-// Renders the case once and runs every method on it (skeleton_fit: a row marked unavailable).
+// Renders the case once and runs every method on it.
 std::vector<MultiviewResult> run_multiview_case(const std::vector<TruthSequence>& clips,
                                                 const MultiviewCase& scene,
                                                 const MultiviewProtocolOptions& options);

@@ -6,6 +6,7 @@
 #include <map>
 #include <numbers>
 #include <stdexcept>
+#include <string>
 
 #include <glm/geometric.hpp>
 #include <glm/trigonometric.hpp>
@@ -76,6 +77,20 @@ glm::dvec3 SceneCamera::centre() const { return -(glm::transpose(R) * t); }
 
 multiview::ViewGeometry SceneCamera::geometry() const {
   return multiview::ViewGeometry::from_krt(K, R, t, width, height);
+}
+
+std::vector<camera::Camera> scene_cameras(std::span<const SceneCamera> cameras) {
+  std::vector<camera::Camera> out;
+  for (std::size_t i = 0; i < cameras.size(); ++i) {
+    const SceneCamera& s = cameras[i];
+    camera::Camera& c = out.emplace_back();
+    c.name = (i + 1 < 10 ? "cam_0" : "cam_") + std::to_string(i + 1);
+    c.width = s.width, c.height = s.height;
+    c.fx = s.K[0][0], c.fy = s.K[1][1], c.cx = s.K[2][0], c.cy = s.K[2][1];
+    c.rotation = s.R;
+    c.translation = s.t;
+  }
+  return out;
 }
 
 std::vector<SceneCamera> ring_rig(int count, double radius_m, double height_m, double height_step_m,

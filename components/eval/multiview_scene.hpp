@@ -14,12 +14,14 @@
 #include <limits>
 #include <optional>
 #include <random>
+#include <span>
 #include <vector>
 
 #include <glm/mat3x3.hpp>
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
+#include "camera/camera.hpp"
 #include "eval/virtual_protocol.hpp"
 #include "multiview/reconstructor.hpp"
 #include "multiview/view_geometry.hpp"
@@ -35,6 +37,10 @@ struct SceneCamera {
   glm::dvec3 centre() const;
   multiview::ViewGeometry geometry() const;
 };
+
+// The scene's cameras as the one camera model (no distortion), named cam_01, cam_02, ...: what
+// the multi-view fit takes.
+std::vector<camera::Camera> scene_cameras(std::span<const SceneCamera> cameras);
 
 // `count` cameras evenly spaced on a circle of `radius_m` around the vertical axis through
 // `target`, at heights alternating between height_m and height_m + height_step_m, each looking at

@@ -12,9 +12,11 @@
 #include "core/input_error.hpp"
 #include "core/keypoint_layout.hpp"
 #include "eval/pose2sim_trial.hpp"
+#include "fit/track_fit.hpp"
 #include "io/openpose_json.hpp"
 #include "io/trc.hpp"
 #include "multiview/reconstructor.hpp"
+#include "multiview/rig_reconstruction.hpp"
 
 namespace mocap::eval {
 namespace {
@@ -52,6 +54,7 @@ std::filesystem::path raw_trc(const std::filesystem::path& trial) {
 
 struct Demo {
   std::vector<camera::Camera> cameras;
+  GroundPlane floor;  // the rig's (Pose2Sim's world: z = 0)
   std::vector<multiview::ViewGeometry> views;
   std::vector<io::OpenPoseSequence> json;  // per camera, in folder name order
   io::TrcFile trc;
@@ -100,7 +103,9 @@ struct Demo {
 Demo load(const std::filesystem::path& trial, const std::filesystem::path& calibration,
           std::size_t max_frames) {
   Demo d;
-  d.cameras = camera::read_rig(calibration).cameras;
+  const camera::Rig rig = camera::read_rig(calibration);
+  d.cameras = rig.cameras;
+  d.floor = multiview::rig_floor(rig);
   for (const auto& c : d.cameras)
     d.views.push_back(
         multiview::ViewGeometry::from_krt(intrinsic_matrix(c), c.rotation, c.translation));
@@ -124,21 +129,52 @@ Demo load(const std::filesystem::path& trial, const std::filesystem::path& calib
   return d;
 }
 
-Pose2SimRun run(const Demo& demo, std::string name, const multiview::ReconstructionOptions& o) {
+// The body joint that is keypoint k itself (not a midpoint), or -1: the markers a fitted body
+// (15 joints) can be compared on.
+int body_joint_of(const multiview::KeypointSet& set, int k) {
+  for (int j = 0; j < kBodyJoints; ++j)
+    if (set.body[j].first == k && set.body[j].second < 0) return j;
+  return -1;
+}
+
+// One reconstruction of the demo (`fit`: + the skeleton fit on all views, full mode, over the
+// tracks, compared on the markers that are body joints).
+Pose2SimRun run(const Demo& demo, std::string name, const multiview::ReconstructionOptions& o,
+                bool fit = false) {
   multiview::ReconstructionOptions options = o;
   options.tracker.fps = static_cast<float>(demo.trc.rate);
-  multiview::MultiViewReconstructor reconstructor(
-      demo.views, multiview::KeypointSet::of(layout(LayoutId::body25b)), options);
+  const multiview::KeypointSet set = multiview::KeypointSet::of(layout(LayoutId::body25b));
+  multiview::MultiViewReconstructor reconstructor(demo.views, set, options);
   Pose2SimRun out;
   out.name = std::move(name);
   out.markers.resize(demo.trc.markers.size());
   out.limb_lengths.resize(pose2sim_limbs().size());
   const auto rhip = demo.trc.marker("RHip"), lhip = demo.trc.marker("LHip");
   if (!rhip || !lhip) throw InputError(demo.trc.path, "no RHip and LHip markers");
-  multiview::FrameObservations obs;
+  std::vector<multiview::FrameObservations> observations(demo.frames);
+  std::vector<multiview::FrameResult> results;
   for (std::size_t i = 0; i < demo.frames; ++i) {
-    demo.observations(i, obs);
-    const multiview::FrameResult& r = reconstructor.process(obs, static_cast<std::int64_t>(i));
+    demo.observations(i, observations[i]);
+    results.push_back(reconstructor.process(observations[i], static_cast<std::int64_t>(i)));
+  }
+  if (fit) {
+    fit::MultiViewFitOptions f;
+    f.cameras = demo.cameras;
+    f.fit = fit::multiview_fit_defaults();
+    f.fit.ground = demo.floor;
+    fit::fit_tracks(observations, results, f, false, set);
+  }
+  // A point of the reconstruction for keypoint k of person p: the keypoint, or with the fit the
+  // body joint it is (nullptr: none).
+  const auto point = [&](const multiview::FrameResult& r, std::size_t p,
+                         int k) -> const multiview::TriangulatedPoint* {
+    if (k < 0) return nullptr;
+    if (!fit) return &r.keypoints_of(p)[static_cast<std::size_t>(k)];
+    const int j = body_joint_of(set, k);
+    return j < 0 ? nullptr : &r.body_of(p)[static_cast<std::size_t>(j)];
+  };
+  for (std::size_t i = 0; i < demo.frames; ++i) {
+    const multiview::FrameResult& r = results[i];
     out.outside_people += r.outside_people;
     const glm::vec3 hips(
         0.5 * (trc_to_world(demo.trc.frames[i][*rhip]) + trc_to_world(demo.trc.frames[i][*lhip])));
@@ -154,26 +190,26 @@ Pose2SimRun run(const Demo& demo, std::string name, const multiview::Reconstruct
     out.other_people += static_cast<int>(r.people.size()) - (participant >= 0);
     if (participant < 0) continue;
     ++out.frames_with_participant;
-    const auto detections = r.detections_of(static_cast<std::size_t>(participant));
-    const auto keypoints = r.keypoints_of(static_cast<std::size_t>(participant));
+    const auto p = static_cast<std::size_t>(participant);
+    const auto detections = r.detections_of(p);
     for (std::size_t l = 0; l < pose2sim_limbs().size(); ++l) {
-      const auto& a = keypoints[body25b_keypoint(pose2sim_limbs()[l].first)];
-      const auto& b = keypoints[body25b_keypoint(pose2sim_limbs()[l].second)];
-      if (a.valid() && b.valid())
-        out.limb_lengths[l].push_back(glm::distance(a.position, b.position));
+      const auto* a = point(r, p, body25b_keypoint(pose2sim_limbs()[l].first));
+      const auto* b = point(r, p, body25b_keypoint(pose2sim_limbs()[l].second));
+      if (a && b && a->valid() && b->valid())
+        out.limb_lengths[l].push_back(glm::distance(a->position, b->position));
     }
     for (std::size_t m = 0; m < demo.trc.markers.size(); ++m) {
       const int k = body25b_keypoint(demo.trc.markers[m]);
-      if (k < 0) continue;
+      const multiview::TriangulatedPoint* ours = point(r, p, k);
+      if (!ours || !ours->valid()) continue;
       const glm::dvec3 theirs = trc_to_world(demo.trc.frames[i][m]);
       Pose2SimMarkerStats& s = out.markers[m];
-      if (!keypoints[k].valid()) continue;
       s.trc_error_all_px.push_back(demo.error_all_px(i, detections, k, theirs));
-      s.distance_m.push_back(glm::distance(keypoints[k].position, glm::vec3(theirs)));
-      s.views.push_back(static_cast<float>(keypoints[k].view_count()));
-      s.error_used_px.push_back(keypoints[k].error_px);
-      s.error_all_px.push_back(
-          demo.error_all_px(i, detections, k, glm::dvec3(keypoints[k].position)));
+      s.distance_m.push_back(glm::distance(ours->position, glm::vec3(theirs)));
+      s.views.push_back(static_cast<float>(ours->view_count()));
+      // A fitted joint is not triangulated from chosen views: no "views used" error.
+      s.error_used_px.push_back(fit ? std::nanf("") : ours->error_px);
+      s.error_all_px.push_back(demo.error_all_px(i, detections, k, glm::dvec3(ours->position)));
     }
   }
   return out;
@@ -257,6 +293,7 @@ Pose2SimComparison compare_with_pose2sim(const std::filesystem::path& trial,
   multiview::ReconstructionOptions rule;
   rule.triangulation.method = multiview::TriangulationMethod::pose2sim;
   c.runs.push_back(run(demo, "Pose2Sim's rule (ours)", rule));
+  c.runs.push_back(run(demo, "ours + skeleton fit (full)", {}, true));
   return c;
 }
 
@@ -268,10 +305,13 @@ std::string pose2sim_table(const Pose2SimComparison& c) {
     << "|---|---|---:|---:|---:|---:|---:|---:|\n";
   const auto row = [&](const std::string& marker, const Pose2SimRun& r,
                        const Pose2SimMarkerStats& m) {
+    if (m.distance_m.empty()) return;  // a marker this reconstruction does not have
     s << "| " << marker << " | " << r.name << " | " << fixed(1000 * median_of(m.distance_m), 1)
       << " | " << fixed(1000 * mean_of(m.distance_m), 1) << " | " << fixed(mean_of(m.views), 2)
-      << " | " << fixed(mean_of(m.error_used_px), 1) << " | " << fixed(mean_of(m.error_all_px), 1)
-      << " | " << fixed(mean_of(m.trc_error_all_px), 1) << " |\n";
+      << " | "
+      << (std::isfinite(mean_of(m.error_used_px)) ? fixed(mean_of(m.error_used_px), 1) : "–")
+      << " | " << fixed(mean_of(m.error_all_px), 1) << " | "
+      << fixed(mean_of(m.trc_error_all_px), 1) << " |\n";
   };
   for (std::size_t m = 0; m < c.markers.size(); ++m)
     for (const Pose2SimRun& r : c.runs) row(c.markers[m], r, r.markers[m]);
@@ -296,7 +336,9 @@ std::string pose2sim_table(const Pose2SimComparison& c) {
   for (const Pose2SimRun& r : c.runs)
     s << r.name << " " << r.frames_with_participant << " (other people reported " << r.other_people
       << "); ";
-  s << "\nSkeleton fitting: n/a (the multi-view fit is not available in this build)\n";
+  s << "\n\nWith skeleton fitting: the fitted 15 body joints, compared on the markers that "
+       "are body joints in BODY_25B's mapping (all 14 here: Neck is UpperNeck, Head HeadTop); "
+       "\"views used\" counts the person's views, the fit uses every one of them.\n";
   return s.str();
 }
 

@@ -4,10 +4,12 @@
 // TRC of the same JSON and calibration, marker by marker (the TRC's markers are BODY_25B
 // keypoints of the same names; Neck is keypoint 17, Head 18).
 //
-// Three reconstructions in one run, each MultiViewReconstructor over the BODY_25B keypoints,
+// Four reconstructions in one run, each MultiViewReconstructor over the BODY_25B keypoints,
 // undistorted with each camera's lens: ours (association, robust triangulation, tracking with its
-// prior), ours without the tracks' prior (per-frame geometry), and our implementation of Pose2Sim's
-// rule (confidence-weighted DLT, views dropped until the mean reprojection error is under 15 px).
+// prior), ours without the tracks' prior (per-frame geometry), our implementation of Pose2Sim's
+// rule (confidence-weighted DLT, views dropped until the mean reprojection error is under 15 px),
+// and ours + the skeleton fit on all views (full mode per track, fit::fit_tracks with
+// multiview_fit_defaults(), the rig's floor), compared on the markers that are body joints.
 // The participant in each frame is the person whose mid-hip is nearest the TRC's (within 0.5 m).
 //
 // Reprojection errors, pixels, per marker: "used" is the triangulator's mean over the views it
@@ -43,14 +45,14 @@ struct Pose2SimComparison {
   std::size_t frames = 0;
   std::vector<std::string> markers;
   std::vector<std::vector<float>> trc_limb_lengths;
-  std::vector<Pose2SimRun> runs;  // ours, ours without the prior, Pose2Sim's rule
+  std::vector<Pose2SimRun> runs;  // ours, without the prior, Pose2Sim's rule, + skeleton fit
 };
 
 // The eight limbs between TRC markers whose length std is reported.
 const std::vector<std::pair<std::string, std::string>>& pose2sim_limbs();
 
 // Reads `trial` (pose/camXX_json in name order = the calibration's cameras; the raw
-// pose-3d/*_0-*.trc, not the filtered one) and runs the three reconstructions on at most
+// pose-3d/*_0-*.trc, not the filtered one) and runs the four reconstructions on at most
 // `max_frames` frames (0: all). Throws InputError naming a file that cannot be read.
 Pose2SimComparison compare_with_pose2sim(const std::filesystem::path& trial,
                                          const std::filesystem::path& calibration,

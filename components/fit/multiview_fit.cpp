@@ -153,7 +153,7 @@ BoneLengths triangulated_bone_lengths(std::span<const MultiViewFrameInput> frame
 }
 
 FitResult fit_multiview_sequence(std::span<const MultiViewFrameInput> frames,
-                                 const MultiViewFitOptions& options) {
+                                 const MultiViewFitOptions& options, double max_seconds) {
   FitResult result;
   result.frames.resize(frames.size());
   std::size_t first = frames.size(), last = 0;
@@ -189,8 +189,8 @@ FitResult fit_multiview_sequence(std::span<const MultiViewFrameInput> frames,
   for (std::size_t i = 0; i < n; ++i) window.push_back({&vars[i], &data[i], false});
   Bones bones = to_bones(start);
   const Bones initial = bones;
-  count(result.stats,
-        solve_window(window, bones, initial, fit, {fit.solve_bones, fit.max_iterations}));
+  count(result.stats, solve_window(window, bones, initial, fit,
+                                   {fit.solve_bones, fit.max_iterations, false, max_seconds}));
   result.bones = from_bones(bones);
   for (std::size_t i = 0; i < n; ++i)
     result.frames[first + i] = output(vars[i], data[i], bones, true);

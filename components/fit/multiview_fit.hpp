@@ -62,9 +62,10 @@ BoneLengths triangulated_bone_lengths(std::span<const MultiViewFrameInput> frame
 
 // Full mode: every frame in one problem, the bone lengths shared and solved (started from the
 // triangulated medians, or options.fit.bones). Frames before the first and after the last
-// triangulated root are invalid.
+// triangulated root are invalid. max_seconds > 0: the solve stops after that long (a stop's
+// quick solve).
 FitResult fit_multiview_sequence(std::span<const MultiViewFrameInput> frames,
-                                 const MultiViewFitOptions& options);
+                                 const MultiViewFitOptions& options, double max_seconds = 0.0);
 
 // Fixed-lag live mode, as LiveFitter: each push solves the newest lag + 1 frames against the two
 // emitted, frozen ones before them and returns the frame that is now `lag` frames old. The bone

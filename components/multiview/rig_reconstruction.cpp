@@ -83,8 +83,9 @@ void RigReconstruction::start(LayoutId keypoints) {
   layout_ = keypoints;
   std::vector<ViewGeometry> views;
   for (const camera::Camera& c : rig_.cameras) views.push_back(from_camera(c));
-  reconstructor_ = std::make_unique<MultiViewReconstructor>(
-      std::move(views), KeypointSet::of(layout(keypoints)), options_);
+  keypoint_set_ = KeypointSet::of(layout(keypoints));
+  reconstructor_ =
+      std::make_unique<MultiViewReconstructor>(std::move(views), keypoint_set_, options_);
 }
 
 void RigReconstruction::add_view(std::size_t camera, const People2D& view) {
@@ -123,6 +124,7 @@ void RigReconstruction::solve(std::span<const People2D* const> views, std::int64
   out.people.clear();
   out.has_ground = true;
   out.ground = floor_;
+  result_ = nullptr;
   if (!layout_) {  // no view at all yet: nothing to solve
     ++counts_.sets;
     ++counts_.partial_sets;
@@ -146,7 +148,8 @@ void RigReconstruction::solve(std::span<const People2D* const> views, std::int64
     if (!present_[c]) ++counts_.missing[c], partial = true;
   }
   counts_.partial_sets += partial ? 1 : 0;
-  emit(reconstructor_->process(observations_, frame), out);
+  result_ = &reconstructor_->process(observations_, frame);
+  emit(*result_, out);
 }
 
 void RigReconstruction::emit(const FrameResult& result, People3D& out) {

@@ -60,6 +60,12 @@ class RigReconstruction {
   const camera::Rig& rig() const { return rig_; }
   const GroundPlane& floor() const { return floor_; }
   const RigReconstructionCounts& counts() const { return counts_; }
+  // The last set's undistorted keypoints and result (nullptr before the first view came), and
+  // how the keypoints make the 15 body joints: what the skeleton fit takes
+  // (fit::MultiViewPeopleFitter).
+  const FrameObservations& observations() const { return observations_; }
+  const FrameResult* last_result() const { return result_; }
+  const KeypointSet& keypoint_set() const { return keypoint_set_; }
 
  private:
   std::size_t camera_index(const std::string& name) const;
@@ -73,6 +79,8 @@ class RigReconstruction {
   GroundPlane floor_;
   std::optional<LayoutId> layout_;
   std::unique_ptr<MultiViewReconstructor> reconstructor_;
+  KeypointSet keypoint_set_;
+  const FrameResult* result_ = nullptr;
   FrameObservations observations_;
   std::vector<std::array<float, 2>> pixels_;  // one person's keypoints, undistorted in place
   std::vector<char> present_;

@@ -47,12 +47,8 @@ TEST(MultiviewProtocol, SmallHeldOutCaseScoresEveryMethod) {
   MultiviewProtocolOptions options;
   options.frames = 30;
   const auto results = run_multiview_case(clips, {4, 2, 0.01f}, options);
-  ASSERT_EQ(results.size(), 4u);
+  ASSERT_EQ(results.size(), 5u);
   for (const auto& r : results) {
-    if (r.method == MultiviewMethod::skeleton_fit) {
-      EXPECT_FALSE(r.available);
-      continue;
-    }
     EXPECT_EQ(r.frames, 30) << method_label(r.method);
     EXPECT_GT(r.score.person_frames, 40) << method_label(r.method);
     EXPECT_GT(r.score.coverage(), 0.8) << method_label(r.method);
@@ -63,8 +59,18 @@ TEST(MultiviewProtocol, SmallHeldOutCaseScoresEveryMethod) {
     EXPECT_LT(r.pa_mpjpe_mm, 80.0) << method_label(r.method);
     EXPECT_TRUE(std::isfinite(r.accel_error_mm) && std::isfinite(r.bone_std_mm));
   }
+  // (iv) fits (iii)'s tracks: the same people, constant bones (the truth's own std is the mocap
+  // skeletons' joint placement, ~2 mm), and not further from the truth.
+  const MultiviewResult& tracked = results[2];
+  for (const MultiviewResult* fitted : {&results[3], &results[4]}) {
+    ASSERT_TRUE(fits_skeleton(fitted->method));
+    EXPECT_EQ(fitted->score.person_frames, tracked.score.person_frames);
+    EXPECT_EQ(fitted->score.id_switches, tracked.score.id_switches);
+    EXPECT_LT(fitted->bone_std_mm, 0.5 * tracked.bone_std_mm) << method_label(fitted->method);
+    EXPECT_LT(fitted->score.mpjpe_mm(), tracked.score.mpjpe_mm()) << method_label(fitted->method);
+  }
   const std::string table = multiview_table(results);
-  EXPECT_NE(table.find("n/a (fit not available)"), std::string::npos) << table;
+  EXPECT_NE(table.find("(iv) + skeleton fit, live"), std::string::npos) << table;
   EXPECT_NE(table.find("(i) baseline"), std::string::npos) << table;
 }
 
@@ -76,7 +82,7 @@ TEST(Pose2SimComparison, FewFramesMatchItsTrc) {
   const Pose2SimComparison c =
       compare_with_pose2sim(test::shared_data() / trial, test::shared_data() / calibration, 12);
   ASSERT_EQ(c.frames, 12u);
-  ASSERT_EQ(c.runs.size(), 3u);
+  ASSERT_EQ(c.runs.size(), 4u);
   for (const Pose2SimRun& r : c.runs) {
     EXPECT_GE(r.frames_with_participant, 10) << r.name;
     std::vector<float> all, trc_px;
@@ -95,6 +101,14 @@ TEST(Pose2SimComparison, FewFramesMatchItsTrc) {
     rule.insert(rule.end(), m.distance_m.begin(), m.distance_m.end());
   EXPECT_LT(median_of(rule), 0.002f);
   EXPECT_NE(pose2sim_table(c).find("| RHip | ours |"), std::string::npos);
+  // With the fit: the markers that are body joints (not Neck and Head), constant limbs.
+  const Pose2SimRun& fitted = c.runs[3];
+  std::size_t compared = 0;
+  for (std::size_t m = 0; m < c.markers.size(); ++m)
+    compared += fitted.markers[m].distance_m.empty() ? 0 : 1;
+  EXPECT_GE(compared, 10u);
+  EXPECT_LT(limb_std_m(fitted.limb_lengths), 0.001f);
+  EXPECT_GT(limb_std_m(c.runs[0].limb_lengths), 0.002f);
 }
 
 }  // namespace

@@ -1,11 +1,14 @@
 // multiview.reconstruct in the single-node harness: People2D of four views made by projecting CMU
 // *train* mocap (two people of the virtual scenes, tests/multiview/scene_fixture.hpp) through a
 // rig built here, with lens distortion, written as a TOML rig file; the node must give the people
-// back in the world, with stable ids, also from partial sets; and the bad input it refuses.
+// back in the world, with stable ids, also from partial sets; and the bad input it refuses. With
+// `fit: live`, noisy keypoints: constant bones, closer to the truth than the triangulation, one
+// output per set in order.
 
 #include <cmath>
 #include <iostream>
 #include <map>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -41,8 +44,11 @@ camera::Rig scene_camera_rig() {
   return rig;
 }
 
-// The people of scene frame `f` seen by camera `c`, in HumanEva-15 (a keypoint per body joint).
-People2D project(const camera::Camera& c, const std::vector<eval::ScenePerson>& people, int f) {
+// The people of scene frame `f` seen by camera `c`, in HumanEva-15 (a keypoint per body joint),
+// with Gaussian noise of `noise_px` pixels (from `random`) when given.
+People2D project(const camera::Camera& c, const std::vector<eval::ScenePerson>& people, int f,
+                 std::mt19937* random = nullptr, double noise_px = 0.0) {
+  std::normal_distribution<double> noise(0.0, noise_px);
   People2D out;
   out.header.frame = f;
   out.header.capture_ns = static_cast<std::int64_t>(f * 1e9 / kSceneFps);
@@ -55,7 +61,8 @@ People2D project(const camera::Camera& c, const std::vector<eval::ScenePerson>& 
     Person2D p;
     p.joints.resize(l.keypoints.size());
     for (int j = 0; j < kBodyJoints; ++j) {
-      const glm::dvec2 px = c.project(glm::dvec3((*body)[j]));
+      glm::dvec2 px = c.project(glm::dvec3((*body)[j]));
+      if (random) px += glm::dvec2(noise(*random), noise(*random));
       if (!std::isfinite(px.x) || px.x < 0 || px.y < 0 || px.x > c.width || px.y > c.height)
         continue;
       p.joints[l.body[j].first] = {static_cast<float>(px.x), static_cast<float>(px.y), 0.9f};
@@ -130,6 +137,100 @@ TEST(MultiViewNode, PeopleInTheWorldWithStableIdsFromFullAndPartialSets) {
             << " joints\n";
   EXPECT_LT(error_sum / joints, 0.01) << "mean joint error, metres";
   EXPECT_NE(node.status().find("cam_3 missing in 12"), std::string::npos) << node.status();
+}
+
+// The mean distance of the people's joints to the nearest scene person's, and per id the
+// standard deviation of each bone's length (the largest), from frame `from` on.
+struct Accuracy {
+  double mean_error_m = 0.0;
+  double worst_bone_std_m = 0.0;
+  int joints = 0;
+};
+
+Accuracy accuracy(const std::vector<std::shared_ptr<const People3D>>& out,
+                  const std::vector<eval::ScenePerson>& people, int from) {
+  Accuracy a;
+  double sum = 0.0;
+  std::map<int, std::array<std::vector<double>, kBodyJoints>> bones;  // id -> per joint
+  for (std::size_t f = static_cast<std::size_t>(from); f < out.size(); ++f) {
+    for (const Person3D& p : out[f]->people) {
+      const auto world = joints_in_frame(p);
+      double best = 1e9;
+      for (const auto& s : people) {
+        double d = 0.0;
+        for (int j = 0; j < kBodyJoints; ++j)
+          d += glm::distance(world[j], (*s.at(static_cast<int>(f)))[j]) / kBodyJoints;
+        best = std::min(best, d);
+      }
+      sum += best * kBodyJoints;
+      a.joints += kBodyJoints;
+      for (int j = 0; j < kBodyJoints; ++j) {
+        if (kJointParent[j] >= 0)  // the root has none
+          bones[p.id][j].push_back(glm::distance(world[j], world[kJointParent[j]]));
+      }
+    }
+  }
+  a.mean_error_m = a.joints > 0 ? sum / a.joints : 1e9;
+  for (const auto& [id, lengths] : bones) {
+    for (const auto& l : lengths) {
+      if (l.size() < 2) continue;
+      double mean = 0.0, square = 0.0;
+      for (double x : l) mean += x / static_cast<double>(l.size());
+      for (double x : l) square += (x - mean) * (x - mean) / static_cast<double>(l.size());
+      a.worst_bone_std_m = std::max(a.worst_bone_std_m, std::sqrt(square));
+    }
+  }
+  return a;
+}
+
+TEST(MultiViewNode, LiveFitGivesConstantBonesCloserToTheTruthOneOutputPerSetInOrder) {
+  MOCAP_REQUIRE_SCENE_CLIPS();
+  constexpr int kFitFrames = 40;
+  Fixture fx;
+  fx.people = scene_people(2, kFitFrames);
+  std::vector<Accuracy> results;
+  for (const char* mode : {"off", "live"}) {
+    graph::Harness node("multiview.reconstruct",
+                        {{"rig", fx.rig_file}, {"fit", mode}, {"bone_frames", "10"}},
+                        views(kCameras));
+    std::mt19937 random(7);  // the same noise for both modes
+    for (int f = 0; f < kFitFrames; ++f)
+      for (int c = 0; c < kCameras; ++c)
+        node.push("view", project(fx.rig.cameras[c], fx.people, f, &random, 4.0),
+                  static_cast<std::size_t>(c));
+    node.finish();
+    const auto out = node.pull<People3D>("out");
+    ASSERT_EQ(out.size(), static_cast<std::size_t>(kFitFrames)) << mode;
+    for (int f = 0; f < kFitFrames; ++f) {
+      EXPECT_EQ(out[static_cast<std::size_t>(f)]->header.frame, f) << mode;
+      if (f >= 2) {  // people are confirmed from their third frame
+        EXPECT_EQ(out[static_cast<std::size_t>(f)]->people.size(), 2u) << mode << f;
+      }
+    }
+    results.push_back(accuracy(out, fx.people, 2));
+    std::cout << "fit " << mode << ": mean joint error " << 1000 * results.back().mean_error_m
+              << " mm, worst bone-length std " << 1000 * results.back().worst_bone_std_m << " mm; "
+              << node.status() << "\n";
+    if (std::string(mode) == "live") {
+      EXPECT_NE(node.status().find("live fit: 76 of 76 person-frames fitted, 2 tracks"),
+                std::string::npos)
+          << node.status();
+    }
+  }
+  EXPECT_GT(results[0].worst_bone_std_m, 0.005);   // 4 px of noise: triangulated bones vary
+  EXPECT_LT(results[1].worst_bone_std_m, 0.0001);  // fitted: one skeleton per track
+  EXPECT_LT(results[1].mean_error_m, results[0].mean_error_m);
+}
+
+TEST(MultiViewNode, AFitModeItDoesNotKnowIsRefusedByGraphValidation) {
+  MOCAP_REQUIRE_SCENE_CLIPS();
+  Fixture fx;
+  try {
+    graph::Harness node("multiview.reconstruct", {{"rig", fx.rig_file}, {"fit", "ful"}}, views(2));
+    FAIL() << "fit: ful was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("full"), std::string::npos) << e.what();
+  }
 }
 
 TEST(MultiViewNode, ACameraTheRigLacksIsRefusedByName) {

@@ -1,10 +1,12 @@
 // `mocap reconstruct --calibration RIG VIEW...` end to end, the real binary on Pose2Sim's demo
 // (../shared/data/eval/pose2sim_demo: 4 views of OpenPose BODY_25B JSON, its calibration TOML,
-// its own triangulation as TRC), the first 30 frames: joints_world against the TRC, the BVH's
-// floor and root, and the bad input it refuses or goes on through.
+// its own triangulation as TRC), the first 30 frames with `--fit full`: joints_world against the
+// TRC, constant bones, the BVH's floor, root and limbs, and the bad input it refuses or goes on
+// through.
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <map>
 #include <string>
@@ -103,7 +105,18 @@ glm::vec3 vec(const json& j) { return {j[0].get<float>(), j[1].get<float>(), j[2
 
 TEST_F(ReconstructMultiView, Pose2SimDemoAgreesWithItsTrcAndTheBvhStandsOnTheFloor) {
   std::string err;
-  ASSERT_EQ(run("demo", args("demo", views_), err), 0) << err;
+  std::vector<std::string> a = args("demo", views_);
+  a.insert(a.end(), {"--fit", "full"});
+  ASSERT_EQ(run("demo", a, err), 0) << err;
+  // "full fit: N of M person-frames fitted": the participant's every frame (the operator, whom
+  // cam01 and cam02 see, has frames without a triangulated root: those keep the triangulation).
+  const auto status = err.find("full fit: ");
+  ASSERT_NE(status, std::string::npos) << err;
+  int fitted = 0, people = 0;
+  ASSERT_EQ(std::sscanf(err.c_str() + status, "full fit: %d of %d", &fitted, &people), 2) << err;
+  EXPECT_GE(fitted, kFrames - 2) << err;
+  EXPECT_LE(fitted, people) << err;
+  EXPECT_EQ(json::parse(read_file(dir_.file("demo") + "/summary.json"))["fit"], "full");
   const io::TrcFile trc =
       io::read_trc(shared_data() / kTrial / "pose-3d" / "S00_P00_T01_BalancingTrial_0-100.trc");
   const std::vector<json> frames = lines("demo");
@@ -143,6 +156,17 @@ TEST_F(ReconstructMultiView, Pose2SimDemoAgreesWithItsTrcAndTheBvhStandsOnTheFlo
   // docs/multiview.md: 19.7 mm median over the 100 frames (our views and weights differ from
   // Pose2Sim's 15 px rule); a wrong axis, lens or camera order gives decimetres.
   EXPECT_LT(median, 0.05f);
+  // Fitted: one skeleton, every bone the same length in every frame (joints_world has 1 mm
+  // steps: lengths vary by 2 mm at most; the triangulation's by centimetres).
+  for (const auto& [bone, joint] : kLimbJoints) {
+    const std::string parent(kJointNames[kJointParent[index(*joint_from_name(joint))]]);
+    float shortest = 1e9f, longest = 0.0f;
+    for (const json& w : bodies) {
+      const float l = glm::distance(vec(w[joint]), vec(w[parent]));
+      shortest = std::min(shortest, l), longest = std::max(longest, l);
+    }
+    EXPECT_LT(longest - shortest, 0.003f) << joint;
+  }
 
   // The participant's BVH: y up, the floor (Pose2Sim's z = 0) at y = 0, the root where
   // joints_world puts it: (x, y, z) of the z-up world is (x, z, -y) in the file.
@@ -160,14 +184,14 @@ TEST_F(ReconstructMultiView, Pose2SimDemoAgreesWithItsTrcAndTheBvhStandsOnTheFlo
     EXPECT_NEAR(global.position[0].y, root.z, 1e-3);
     EXPECT_NEAR(global.position[0].z, -root.y, 1e-3);
     for (const glm::vec3& p : global.position) lowest = std::min(lowest, p.y);
-    // The limbs point where the joints are: the file's joints within the bone lengths' change
-    // since the first frame (a wrong rotation puts a hand or foot decimetres off).
+    // The limbs point where the joints are: the file's joints where joints_world has them (its
+    // bones are the fit's: constant; a wrong rotation puts a hand or foot decimetres off).
     for (const auto& [bone, joint] : kLimbJoints) {
       const json& w = bodies[static_cast<std::size_t>(f)][joint];
       if (w[0].is_null()) continue;
       const glm::vec3 world = vec(w);
       const glm::vec3 at = global.position[static_cast<std::size_t>(clip.skeleton.find(bone))];
-      EXPECT_LT(glm::distance(at, glm::vec3(world.x, world.z, -world.y)), 0.08f)
+      EXPECT_LT(glm::distance(at, glm::vec3(world.x, world.z, -world.y)), 0.01f)
           << bone << " at frame " << f;
     }
   }

@@ -151,7 +151,7 @@ std::string quoted(const std::string& text) { return json(text).dump(); }
 // The graph of graphs/multiview_json.yaml (and its video form) for these views.
 std::string graph_text(const std::vector<View>& views, const std::string& rig_file,
                        const fs::path& out, double fps, const std::string& detector,
-                       const std::string& trc_world_up) {
+                       const std::string& trc_world_up, const std::string& fit) {
   const std::string rate = json(fps).dump();
   std::ostringstream g;
   g << "graph: multiview_reconstruct\nnodes:\n";
@@ -174,7 +174,7 @@ std::string graph_text(const std::vector<View>& views, const std::string& rig_fi
     g << " } }\n";
   }
   g << "  solve: { type: multiview.reconstruct, params: { rig: " << quoted(rig_file)
-    << ", fps: " << rate << " } }\n"
+    << ", fps: " << rate << ", fit: " << fit << " } }\n"
     << "  jsonl: { type: sink.jsonl, params: { path: " << quoted((out / "poses.jsonl").string())
     << " } }\n"
     << "  bvh: { type: sink.bvh_joints, params: { dir: " << quoted(out.string())
@@ -296,6 +296,12 @@ int reconstruct_multiview_command(int argc, char** argv) {
       .option("detector", "NAME",
               "videos and image folders: how people are found, one of " + detector_names(),
               std::string(kFileDetector))
+      .option("fit", "auto|off|live|full",
+              "skeleton fit on all views (constant bone lengths per person, smooth, feet above "
+              "the floor): full in windows of 300 frames per person overlapping by 30 (written "
+              "as each window is solved), live with a 3-frame lag (a new person's first 30 "
+              "frames held for their bone lengths); auto: full for files, live for cameras",
+              "auto")
       .option("offsets", "auto|N,N,...",
               "views filmed without a common clock: per view the frames it is shifted by (its "
               "frame i shows the first view's frame i + N), or auto: estimated from the people "
@@ -311,6 +317,10 @@ int reconstruct_multiview_command(int argc, char** argv) {
   if (!args.has("calibration")) throw InputError("--calibration", "required: the rig file");
   const std::string rig_file = args.get("calibration");
   const fs::path out = args.get("out");
+  std::string fit = args.get("fit");
+  if (fit != "auto" && fit != "off" && fit != "live" && fit != "full")
+    throw InputError("--fit", "expected auto, off, live or full, got '" + fit + "'");
+  if (fit == "auto") fit = "full";  // every view is a file (JSON, video, images): fitted offline
 
   // Everything that can be checked before DIR is touched.
   const camera::Rig rig = camera::read_rig(rig_file);
@@ -342,7 +352,7 @@ int reconstruct_multiview_command(int argc, char** argv) {
 
   graph::load_plugins_from_environment();
   graph::GraphSpec spec = graph::parse_graph_text(
-      graph_text(views, rig_file, out, fps, args.get("detector"), trc_world_up),
+      graph_text(views, rig_file, out, fps, args.get("detector"), trc_world_up, fit),
       "mocap reconstruct");
   graph::apply_overrides(spec, args.all("set"));
   check_detector_model(spec);
@@ -376,6 +386,7 @@ int reconstruct_multiview_command(int argc, char** argv) {
   summary["views"] = view_list;
   summary["fps"] = fps;
   summary["floor"] = floor_how;
+  summary["fit"] = fit;
   return finish_reconstruct(run, summary, out, frames);
 }
 

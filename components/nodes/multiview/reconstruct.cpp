@@ -1,13 +1,17 @@
 // multiview.reconstruct: several calibrated views of one scene, joined by frame, to the people in
 // the rig's world (multiview/rig_reconstruction.hpp: undistortion, association, triangulation,
-// tracking). People seen by one view only are dropped and counted.
+// tracking). People seen by one view only are dropped and counted. `fit`: each track's skeleton
+// fitted on all views (fit::MultiViewPeopleFitter: constant bones, live = fixed lag, full =
+// windows), one output per input set, in order.
 
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "camera/rig_file.hpp"
 #include "core/input_error.hpp"
+#include "fit/multiview_people_fitter.hpp"
 #include "graph/registry.hpp"
 #include "multiview/rig_reconstruction.hpp"
 
@@ -29,6 +33,17 @@ class MultiViewReconstructNode : public Node {
     c.param<double>("fps", 30.0, "frame rate: tracks predict and expire in seconds",
                     {0.1, 10000.0});
     c.param<bool>("report_tentative", false, "report people from their first frame");
+    c.param_choice("fit", "off", {"off", "live", "full"},
+                   "skeleton fit on all views: off (triangulated joints), live (fixed lag; a new "
+                   "person's first bone_frames frames held) or full (windows, offline)");
+    c.param<int>("lag", 3, "live fit: frames of look-ahead before a frame is output", {0, 100});
+    c.param<int>("bone_frames", 30, "live fit: a new person's frames that give the bone lengths",
+                 {1, 10000});
+    c.param<int>("window", 300, "full fit: frames solved together", {2, 100000});
+    c.param<int>("overlap", 30, "full fit: frames of a window solved again with the next",
+                 {0, 99999});
+    c.param<int>("max_missed", 10, "fit: frames a person may be missing before their fit ends",
+                 {0, 10000});
   }
 
   void open(Context& ctx) override {
@@ -46,6 +61,18 @@ class MultiViewReconstructNode : public Node {
     options.tracker.fps = ctx.param<double>("fps");
     options.report_tentative = ctx.param<bool>("report_tentative");
     solver_ = std::make_unique<multiview::RigReconstruction>(camera::read_rig(file), file, options);
+    if (const auto mode = ctx.param<std::string>("fit"); mode != "off") {
+      fit::MultiViewPeopleFitOptions o;
+      o.mode = mode == "full" ? fit::StreamFitMode::full : fit::StreamFitMode::live;
+      o.fit.cameras = solver_->rig().cameras;
+      o.fit.fit = fit::multiview_fit_defaults();
+      o.fit.fit.ground = solver_->floor();
+      o.fit.fit.lag = ctx.param<int>("lag");
+      o.fit.bone_frames = ctx.param<int>("bone_frames");
+      o.window = {ctx.param<int>("window"), ctx.param<int>("overlap")};
+      o.max_missed = ctx.param<int>("max_missed");
+      fitter_.emplace(std::move(o));
+    }
     views_.resize(ctx.input_count("view"));
     if (views_.size() > solver_->rig().cameras.size())
       throw InputError(file, std::to_string(views_.size()) + " views but " +
@@ -64,19 +91,38 @@ class MultiViewReconstructNode : public Node {
     out.header = *header;
     out.header.stream = ctx.node_name();
     solver_->solve(views_, header->frame, out);
-    ctx.send("out", std::move(out));
+    if (!fitter_) {
+      ctx.send("out", std::move(out));
+    } else {
+      if (ctx.stop_requested()) fitter_->stop();  // the drain: no long solve from now on
+      const multiview::FrameResult* result = solver_->last_result();
+      send(ctx, result ? fitter_->push(solver_->observations(), *result, solver_->keypoint_set(),
+                                       std::move(out))
+                       : fitter_->push(std::move(out)));
+    }
     if (solver_->counts().sets % 30 == 1)
       ctx.report_status(solver_->counts().describe(solver_->rig()));
   }
 
   void close(Context& ctx) override {
     if (!solver_) return;
-    ctx.report_status(solver_->counts().describe(solver_->rig()));
-    std::cerr << ctx.node_name() << ": " << solver_->counts().describe(solver_->rig()) << "\n";
+    std::string status = solver_->counts().describe(solver_->rig());
+    if (fitter_) {
+      if (ctx.stop_requested()) fitter_->stop();
+      send(ctx, fitter_->finish());
+      status += "; " + fitter_->summary();
+    }
+    ctx.report_status(status);
+    std::cerr << ctx.node_name() << ": " << status << "\n";
   }
 
  private:
+  static void send(Context& ctx, std::vector<People3D> frames) {
+    for (People3D& frame : frames) ctx.send("out", std::move(frame));
+  }
+
   std::unique_ptr<multiview::RigReconstruction> solver_;
+  std::optional<fit::MultiViewPeopleFitter> fitter_;
   std::vector<const People2D*> views_;
 };
 

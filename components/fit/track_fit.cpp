@@ -1,36 +1,21 @@
-#include "fit/scene_fit.hpp"
+#include "fit/track_fit.hpp"
 
 #include <map>
-#include <string>
 #include <utility>
 
 #include "fit/multiview_input.hpp"
 
 namespace mocap::fit {
 
-std::vector<camera::Camera> scene_cameras(std::span<const eval::SceneCamera> cameras) {
-  std::vector<camera::Camera> out;
-  for (std::size_t i = 0; i < cameras.size(); ++i) {
-    const eval::SceneCamera& s = cameras[i];
-    camera::Camera& c = out.emplace_back();
-    c.name = (i + 1 < 10 ? "cam_0" : "cam_") + std::to_string(i + 1);
-    c.width = s.width, c.height = s.height;
-    c.fx = s.K[0][0], c.fy = s.K[1][1], c.cx = s.K[2][0], c.cy = s.K[2][1];
-    c.rotation = s.R;
-    c.translation = s.t;
-  }
-  return out;
-}
-
 TrackFits fit_tracks(std::span<const multiview::FrameObservations> input,
                      std::vector<multiview::FrameResult>& results,
-                     const MultiViewFitOptions& options, bool live) {
+                     const MultiViewFitOptions& options, bool live,
+                     const multiview::KeypointSet& set) {
   // Each track's (frame, person) in frame order.
   std::map<int, std::vector<std::pair<std::size_t, std::size_t>>> tracks;
   for (std::size_t f = 0; f < results.size() && f < input.size(); ++f)
     for (std::size_t p = 0; p < results[f].people.size(); ++p)
       if (results[f].people[p].id >= 0) tracks[results[f].people[p].id].emplace_back(f, p);
-  const multiview::KeypointSet set = multiview::KeypointSet::body15();
   TrackFits out;
   for (const auto& [id, seen] : tracks) {
     const std::size_t first = seen.front().first, last = seen.back().first;
