@@ -7,10 +7,11 @@
 
 namespace mocap::detect {
 
-std::vector<SquareRegion> proposal_tiles(int width, int height, int tiles) {
+std::vector<SquareRegion> proposal_tiles(int width, int height, int tiles, bool whole_frame) {
   if (tiles < 1) throw std::invalid_argument("the person detector needs at least one tile");
   const float w = static_cast<float>(width), h = static_cast<float>(height);
-  if (tiles == 1 || width == height) return {{w / 2, h / 2, 0.0f}};
+  const SquareRegion whole{w / 2, h / 2, 0.0f};
+  if (tiles == 1 || width == height) return {whole};
   const bool wide = width > height;
   const float side = wide ? h : w, span = (wide ? w : h) - side;
   std::vector<SquareRegion> out;
@@ -18,13 +19,14 @@ std::vector<SquareRegion> proposal_tiles(int width, int height, int tiles) {
     const float centre = side / 2 + span * static_cast<float>(i) / static_cast<float>(tiles - 1);
     out.push_back(wide ? SquareRegion{centre, h / 2, side} : SquareRegion{w / 2, centre, side});
   }
+  if (whole_frame) out.push_back(whole);
   return out;
 }
 
 std::vector<Detection> propose_people(CenternetNetwork& network, const ImageBuffer& frame,
                                       const ProposalOptions& options, GraphTensor& input) {
   const std::vector<SquareRegion> tiles =
-      proposal_tiles(frame.width(), frame.height(), options.tiles);
+      proposal_tiles(frame.width(), frame.height(), options.tiles, options.whole_frame);
   const bool wide = frame.width() >= frame.height();
   std::vector<Detection> all;
   for (std::size_t t = 0; t < tiles.size(); ++t) {
@@ -38,11 +40,16 @@ std::vector<Detection> propose_people(CenternetNetwork& network, const ImageBuff
     const std::vector<GraphTensor>& heads = network.run(input);
     std::vector<Detection> found =
         decode_centernet(heads[0], heads[1], kCenternetPersonClass, options.min_score, -1);
-    // This tile's share of the long side: up to the middle of its overlap with each neighbour.
+    // A tile's share of the long side: up to the middle of its overlap with each neighbour tile.
+    // The whole frame (side 0) keeps everything it finds.
     const float centre = wide ? r.cx : r.cy;
-    const float low = t == 0 ? -1e9f : (centre + (wide ? tiles[t - 1].cx : tiles[t - 1].cy)) / 2;
-    const float high =
-        t + 1 == tiles.size() ? 1e9f : (centre + (wide ? tiles[t + 1].cx : tiles[t + 1].cy)) / 2;
+    const auto tile_centre = [&](std::size_t i) {
+      return tiles[i].side == 0 ? 0.0f : (wide ? tiles[i].cx : tiles[i].cy);
+    };
+    const bool has_previous = r.side != 0 && t > 0 && tiles[t - 1].side != 0;
+    const bool has_next = r.side != 0 && t + 1 < tiles.size() && tiles[t + 1].side != 0;
+    const float low = has_previous ? (centre + tile_centre(t - 1)) / 2 : -1e9f;
+    const float high = has_next ? (centre + tile_centre(t + 1)) / 2 : 1e9f;
     const float sx = r.side == 0 ? static_cast<float>(frame.width()) / kCenternetInput
                                  : r.side / kCenternetInput;
     const float sy = r.side == 0 ? static_cast<float>(frame.height()) / kCenternetInput

@@ -4,7 +4,9 @@
 // (1280 × 720: by 0.40 across, 0.71 down) and shrinks them; square tiles of the frame's short
 // side keep their shape, and each tile keeps the detections whose centre lies in its own share of
 // the frame (the overlap split at its middle), so a person narrower than the overlap is found
-// whole by exactly one tile. The detections of all tiles are then thinned by NMS.
+// whole by exactly one tile. A person wider than the overlap (a close-up) is cut by every tile;
+// `whole_frame` adds one pass over the whole frame stretched, which sees them whole. The
+// detections of all passes are then thinned by NMS.
 
 #include <vector>
 
@@ -20,11 +22,16 @@ struct ProposalOptions {
   // 1: the whole frame stretched to the input (the model's users' way). N > 1: N square tiles
   // of the frame's short side spread evenly along its long side (none when the frame is square).
   int tiles = 1;
+  // With tiles > 1: one more pass over the whole frame stretched, for the people wider than the
+  // tiles' overlap.
+  bool whole_frame = false;
 };
 
 // The square regions the detector sees for a frame of width × height (one stretched region is
-// returned as the frame's bounding square with side 0: callers stretch the whole frame).
-std::vector<SquareRegion> proposal_tiles(int width, int height, int tiles);
+// returned as the frame's centre with side 0: callers stretch the whole frame), the whole frame
+// last when `whole_frame` adds it to several tiles.
+std::vector<SquareRegion> proposal_tiles(int width, int height, int tiles,
+                                         bool whole_frame = false);
 
 // Person detections in frame pixels, best first. `input` is the network's input, reused between
 // calls. Throws std::invalid_argument for tiles < 1.

@@ -30,6 +30,8 @@ void check(const TopDownOptions& o) {
   if (o.min_keypoints < 1 || o.min_keypoints > kMovenetKeypoints)
     throw std::invalid_argument("min_keypoints must lie in [1, 17]");
   if (o.detector_tiles < 1) throw std::invalid_argument("detector_tiles must be at least 1");
+  if (!(o.sure_box_score >= 0.0f && o.sure_box_score <= 1.0f))
+    throw std::invalid_argument("sure_box_score must lie in [0, 1] (0: off)");
   if (o.workers < 1 || o.workers > 16) throw std::invalid_argument("workers must lie in [1, 16]");
   if (o.keypoint_every < 1) throw std::invalid_argument("keypoint_every must be at least 1");
   if (!(o.flow_error > 0.0f && o.flow_error <= 1.0f))
@@ -107,9 +109,11 @@ void TopDownDetector::warm_up() {
 
 std::vector<Detection> TopDownDetector::find_boxes(const ImageBuffer& frame) {
   const auto start = Clock::now();
-  std::vector<Detection> found = propose_people(
-      *boxes_, frame, {options_.min_box_score, options_.box_overlap, options_.detector_tiles},
-      image_);
+  std::vector<Detection> found =
+      propose_people(*boxes_, frame,
+                     {options_.min_box_score, options_.box_overlap, options_.detector_tiles,
+                      options_.detector_whole_frame},
+                     image_);
   ++profile_.detector_runs;
   profile_.centernet += seconds_since(start);
   return found;
@@ -148,7 +152,8 @@ void TopDownDetector::add_crops(const ImageBuffer& frame, std::span<const Box2D>
   image_batch(crops_, count, size, size);
   const int first = static_cast<int>(found_.size());
   for (int i = 0; i < count; ++i) {
-    regions_.push_back(square_around(boxes[static_cast<std::size_t>(i)], options_.crop_padding));
+    crop_boxes_.push_back(boxes[static_cast<std::size_t>(i)]);
+    regions_.push_back(square_around(crop_boxes_.back(), options_.crop_padding));
     fill_region(frame, regions_.back(), crops_, i);
   }
   found_.resize(found_.size() + boxes.size());
@@ -174,11 +179,15 @@ void TopDownDetector::people_found(std::vector<Found>& found) const {
         out = {std::nanf(""), std::nanf(""), 0.0f};
       }
     }
-    if (passing < options_.min_keypoints) continue;
-    person.score = sum / static_cast<float>(passing);
-    if (person.score < options_.min_person_score) continue;
-    person.box = keypoint_box(person.keypoints, kHeadMargin);
-    found.push_back({person, 0});
+    person.score = passing > 0 ? sum / static_cast<float>(passing) : 0.0f;
+    const bool posed =
+        passing >= options_.min_keypoints && person.score >= options_.min_person_score;
+    const float box_score = box_scores_[i];
+    const bool sure = options_.sure_box_score > 0 && box_score >= options_.sure_box_score;
+    if (!posed && !sure) continue;
+    // Keypoints too unsure to outline the person: the detector's box does.
+    person.box = posed ? keypoint_box(person.keypoints, kHeadMargin) : crop_boxes_[i];
+    found.push_back({person, 0, box_score, posed});
   }
 }
 
@@ -232,7 +241,7 @@ void TopDownDetector::carry(std::vector<Found>& out) {
       ++p;
     }
     person.box = moved(person.box, dx, dy);
-    out.push_back({person, f.carried + 1});
+    out.push_back({person, f.carried + 1, f.box_score, true});
     carried_[i] = 1;
     ++profile_.carried;
   }
@@ -250,12 +259,17 @@ std::vector<MovenetPerson> TopDownDetector::detect(const ImageBuffer& frame) {
   std::vector<Found> found;
   carry(found);
   std::vector<Box2D> boxes;
-  for (std::size_t i = 0; i < followed_.size(); ++i)
-    if (!carried_[i]) boxes.push_back(moved(followed_[i].box, followed_[i].vx, followed_[i].vy));
+  box_scores_.clear();
+  for (std::size_t i = 0; i < followed_.size(); ++i) {
+    if (carried_[i]) continue;
+    boxes.push_back(moved(followed_[i].box, followed_[i].vx, followed_[i].vy));
+    box_scores_.push_back(followed_[i].box_score);
+  }
   const bool run_detector =
       frame_ % options_.detect_every == 0 || lost_someone_ || followed_.empty();
   ++frame_;
   regions_.clear();
+  crop_boxes_.clear();
   found_.clear();
   const int copies = static_cast<int>(poses_.size());
   std::size_t cropped = 0;  // boxes whose keypoints are found
@@ -283,6 +297,13 @@ std::vector<MovenetPerson> TopDownDetector::detect(const ImageBuffer& frame) {
       profile_.centernet_wait += seconds_since(running);
     }
     const std::size_t followed = boxes.size();
+    // A followed person's detector score is the best of the boxes that are them (0: none).
+    for (std::size_t i = 0; i < followed; ++i) {
+      box_scores_[i] = 0;
+      for (const Detection& d : detections)
+        if (iou(boxes[i], d.box) > options_.followed_overlap)
+          box_scores_[i] = std::max(box_scores_[i], d.score);
+    }
     for (const Detection& d : detections) {
       const auto overlaps = [&](const Box2D& b) {
         return iou(b, d.box) > options_.followed_overlap;
@@ -292,27 +313,32 @@ std::vector<MovenetPerson> TopDownDetector::detect(const ImageBuffer& frame) {
                       overlaps) ||
           std::any_of(found.begin(), found.end(),
                       [&](const Found& c) { return overlaps(c.person.box); });
-      if (!known) boxes.push_back(d.box);
+      if (!known) {
+        boxes.push_back(d.box);
+        box_scores_.push_back(d.score);
+      }
     }
   }
   add_crops(frame, std::span<const Box2D>(boxes).subspan(cropped), copies);
   people_found(found);
   std::vector<MovenetPerson> people;
-  std::vector<int> carried;  // per person: frames since their keypoint pass
+  std::vector<std::size_t> kept;  // per person: their index in `found`
   {
+    // Of two finds of one person, the posed one wins (ranked first whatever its score).
     std::vector<MovenetPerson> candidates;
-    for (const Found& f : found) candidates.push_back(f.person);
-    for (const std::size_t i : distinct_people(candidates, options_.duplicate_overlap)) {
-      people.push_back(found[i].person);
-      carried.push_back(found[i].carried);
+    for (const Found& f : found) {
+      candidates.push_back(f.person);
+      if (f.posed) candidates.back().score += 1;
     }
+    kept = distinct_people(candidates, options_.duplicate_overlap);
+    for (const std::size_t i : kept) people.push_back(found[i].person);
   }
 
   // The next frame's crops: each person's box, moved by how far their nearest predecessor moved.
   std::vector<Followed> next;
   for (std::size_t i = 0; i < people.size(); ++i) {
     const MovenetPerson& p = people[i];
-    Followed f{p.box, 0, 0, p, carried[i]};
+    Followed f{p.box, 0, 0, p, found[kept[i]].carried, found[kept[i]].box_score};
     const float cx = p.box.x + p.box.width / 2, cy = p.box.y + p.box.height / 2;
     float best = 0.3f;  // the predecessor must overlap the person this much
     for (const Followed& old : followed_) {

@@ -42,6 +42,9 @@ struct TopDownOptions {
   // The person detector on the whole frame stretched (1) or on this many square tiles of a wide
   // frame (person_proposals.hpp).
   int detector_tiles = 1;
+  // With detector_tiles > 1: one more detector pass over the whole frame stretched, for the
+  // people wider than the tiles' overlap (close-ups); all passes merged by NMS.
+  bool detector_whole_frame = false;
   // A detector box overlapping a followed person's box by more than this is that person.
   float followed_overlap = 0.3f;
   float crop_padding = 1.25f;       // crop side = longer box side × this
@@ -50,6 +53,11 @@ struct TopDownOptions {
   // min_person_score.
   int min_keypoints = 6;
   float min_person_score = 0.35f;
+  // A person the detector is sure of: a box scoring at least this is a person even when its
+  // crop's keypoints fail the test above (blurred or crowded people); only the keypoints scoring
+  // min_keypoint_score are kept, and the box is the detector's. Such a person is followed until
+  // the next detector run, which keeps them only if it still finds them this sure. 0: off.
+  float sure_box_score = 0.0f;
   float duplicate_overlap = 0.6f;  // people whose boxes overlap more are one
   // The network runtime of both networks and their threads (graph_runner.hpp: XNNPACK's are each
   // network's own, 0 meaning one; cv::dnn's are process-wide, 0 its default).
@@ -111,16 +119,21 @@ class TopDownDetector {
     float vx = 0, vy = 0;  // motion of the box centre per frame
     MovenetPerson person;  // their keypoints in the last frame
     int carried = 0;       // frames since their last keypoint pass
+    float box_score = 0;   // the detector's score of them at its last run (0: not found by it)
   };
-  // A person found in this frame and how many frames their keypoints have been carried (0: a
-  // keypoint pass).
+  // A person found in this frame, how many frames their keypoints have been carried (0: a
+  // keypoint pass), the detector's score of them, and whether their keypoints passed the person
+  // test (or the detector's score alone kept them).
   struct Found {
     MovenetPerson person;
     int carried = 0;
+    float box_score = 0;
+    bool posed = true;
   };
   std::vector<Detection> find_boxes(const ImageBuffer& frame);
   // Keypoints of a crop for each box, appended to found_ (regions_ gets their squares), the
   // crops shared by the first `copies` copies of the keypoint network.
+  // box_scores_ holds, per box of the frame, the detector's score of it.
   void add_crops(const ImageBuffer& frame, std::span<const Box2D> boxes, int copies);
   // Keypoints of crops_[0, count) into found_[first, first + count), on `copies` copies at once.
   void run_keypoints(int first, int count, int copies);
@@ -136,6 +149,8 @@ class TopDownDetector {
   std::unique_ptr<OrderedWorkers<int>> helpers_;  // workers - 1 threads; none with one worker
   GraphTensor image_, crops_;  // the networks' inputs, reused from frame to frame
   std::vector<SquareRegion> regions_;
+  std::vector<Box2D> crop_boxes_;  // per crop of the frame: the box it was cut around
+  std::vector<float> box_scores_;  // per box of the frame: the detector's score of it
   std::vector<SinglePoseKeypoints> found_;
   std::vector<Followed> followed_;
   std::unique_ptr<KeypointFlow> flow_;  // with keypoint_every > 1

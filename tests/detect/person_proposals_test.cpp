@@ -3,9 +3,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <memory>
 #include <stdexcept>
+#include <vector>
 
 #include <opencv2/imgcodecs.hpp>
 
@@ -44,6 +46,15 @@ TEST(PersonProposalTiles, OneTileOrASquareFrameIsTheWholeFrameStretched) {
   EXPECT_THROW(proposal_tiles(1280, 720, 0), std::invalid_argument);
 }
 
+TEST(PersonProposalTiles, TheWholeFrameComesLastWhenAdded) {
+  const auto tiles = proposal_tiles(1280, 720, 2, true);
+  ASSERT_EQ(tiles.size(), 3u);
+  EXPECT_FLOAT_EQ(tiles[0].side, 720);
+  EXPECT_FLOAT_EQ(tiles[1].side, 720);
+  EXPECT_EQ(tiles[2].side, 0.0f);
+  EXPECT_EQ(proposal_tiles(1280, 720, 1, true).size(), 1u);  // one tile is the whole frame
+}
+
 // vtest.avi frame 300 (768 x 576, walkers 60-110 px tall), the golden tests' frame.
 TEST(PersonProposals, TilesFindThePeopleTheStretchedFrameFinds) {
   const fs::path frame_file =
@@ -80,6 +91,59 @@ TEST(PersonProposals, TilesFindThePeopleTheStretchedFrameFinds) {
     EXPECT_LT(t.box.x, frame.width());
   }
   for (std::size_t i = 1; i < found.size(); ++i) EXPECT_GE(found[i - 1].score, found[i].score);
+}
+
+// COCO_val2014_000000000241 (480 x 640, portrait): the man in front is 612 px tall, taller than
+// a 480-px tile, so each tile sees only part of him; the whole-frame pass sees him whole, and
+// the merged proposals keep that box and what either pass found.
+TEST(PersonProposals, TheWholeFramePassBringsBackAPersonLargerThanTheTiles) {
+  const fs::path image_file = fs::path("..") / "shared" / "data" / "eval" /
+                              "openpose_examples_media" / "COCO_val2014_000000000241.jpg";
+  fs::path model;
+  try {
+    model = cached_model_json("centernet");
+  } catch (const ModelMissing& e) {
+    GTEST_SKIP() << e.what();
+  }
+  if (!fs::exists(image_file)) GTEST_SKIP() << "COCO still absent: " << image_file;
+  auto pixels = std::make_shared<cv::Mat>(cv::imread(image_file.string()));
+  ASSERT_FALSE(pixels->empty());
+  const ImageBuffer frame(pixels->cols, pixels->rows, static_cast<int>(pixels->step[0]),
+                          PixelFormat::bgr8, pixels,
+                          reinterpret_cast<const std::byte*>(pixels->data));
+  CenternetNetwork network(model);
+  GraphTensor input;
+  ProposalOptions whole, tiled, both;
+  tiled.tiles = both.tiles = 2;
+  both.whole_frame = true;
+  const auto from_whole = propose_people(network, frame, whole, input);
+  const auto from_tiles = propose_people(network, frame, tiled, input);
+  const auto merged = propose_people(network, frame, both, input);
+  const Box2D front{126, 4, 206, 612};  // the hand-checked box (tests/data/detection)
+  const auto finds = [&](const std::vector<Detection>& found, const Box2D& box) {
+    return std::any_of(found.begin(), found.end(),
+                       [&](const Detection& d) { return iou(d.box, box) >= 0.5f; });
+  };
+  // Each tile outlines the part of him it sees (two boxes, IoU 0.66 and 0.70 with his); the
+  // whole frame outlines all of him, and NMS keeps that box alone.
+  const auto near_him = [&](const std::vector<Detection>& found) {
+    std::vector<float> overlaps;
+    for (const Detection& d : found)
+      if (iou(d.box, front) >= 0.3f) overlaps.push_back(iou(d.box, front));
+    return overlaps;
+  };
+  const auto cut = near_him(from_tiles);
+  EXPECT_GE(cut.size(), 2u) << "the tiles alone should see him in parts";
+  for (const float v : cut) EXPECT_LT(v, 0.8f);
+  const auto whole_man = near_him(merged);
+  ASSERT_EQ(whole_man.size(), 1u);
+  EXPECT_GT(whole_man.front(), 0.8f);
+  EXPECT_TRUE(finds(from_whole, front));
+  EXPECT_TRUE(finds(merged, front));
+  for (const auto* found : {&from_whole, &from_tiles})
+    for (const Detection& d : *found)
+      EXPECT_TRUE(finds(merged, d.box)) << d.box.x << " " << d.box.y;
+  for (std::size_t i = 1; i < merged.size(); ++i) EXPECT_GE(merged[i - 1].score, merged[i].score);
 }
 
 }  // namespace

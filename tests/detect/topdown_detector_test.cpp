@@ -19,6 +19,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "detect/model_files.hpp"
+#include "detect/person_proposals.hpp"
 #include "detect/topdown_detector.hpp"
 
 namespace mocap::detect {
@@ -105,6 +106,52 @@ TEST(TopDownDetector, TwoWorkersFindWhatOneFinds) {
     EXPECT_GT(p->centernet, 0.0);
     EXPECT_GE(p->total, p->keypoints + p->crop_fill);
   }
+}
+
+// The person test made strict (all 17 keypoints at 0.6), so that the crops of frame 300 fail
+// it: with sure_box_score the boxes CenterNet scores at least that stay people, with the
+// detector's box and only their confident keypoints, and are followed to the next detector run.
+TEST(TopDownDetector, ABoxTheDetectorIsSureOfIsAPersonWhateverItsKeypoints) {
+  std::string why;
+  const auto m = models(why);
+  if (!m) GTEST_SKIP() << why;
+  TopDownOptions o;
+  o.min_keypoints = 17;
+  o.min_keypoint_score = 0.6f;
+  o.detect_every = 10;
+  const auto run = [&](float sure, long long& detector_runs) {
+    o.sure_box_score = sure;
+    TopDownDetector detector(o, m->lightning, m->centernet);
+    std::vector<std::vector<MovenetPerson>> out;
+    for (int i = 0; i < 3; ++i) out.push_back(detector.detect(shifted_frame(2 * i)));
+    detector_runs = detector.detector_runs();
+    return out;
+  };
+  long long strict_runs = 0, sure_runs = 0;
+  const auto strict = run(0.0f, strict_runs);
+  const auto sure = run(0.5f, sure_runs);
+  EXPECT_LE(strict.front().size(), 1u) << "the strict test should reject frame 300's crops";
+  // CenterNet's own boxes scoring 0.5 or more on the first frame.
+  CenternetNetwork network(m->centernet);
+  GraphTensor input;
+  ProposalOptions confident;
+  confident.min_score = 0.5f;
+  const auto boxes = propose_people(network, shifted_frame(0), confident, input);
+  ASSERT_GE(boxes.size(), 3u) << "the walkers of frame 300 score 0.55-0.67";
+  ASSERT_GE(sure.front().size(), boxes.size());
+  for (const Detection& d : boxes) {
+    const bool kept =
+        std::any_of(sure.front().begin(), sure.front().end(),
+                    [&](const MovenetPerson& p) { return iou(p.box, d.box) > 0.99f; });
+    EXPECT_TRUE(kept) << "the box at x " << d.box.x << " is not a person";
+  }
+  for (const auto& frame : sure) {
+    EXPECT_GE(frame.size(), boxes.size()) << "followed between detector runs";
+    for (const MovenetPerson& p : frame)
+      for (const Keypoint2D& k : p.keypoints)
+        EXPECT_TRUE(std::isnan(k.x) || k.confidence >= o.min_keypoint_score);
+  }
+  EXPECT_EQ(sure_runs, 1) << "nobody sure is lost between detector runs";
 }
 
 TEST(TopDownDetector, PartOfABatchEqualsThatPartOfTheWholeRun) {

@@ -98,17 +98,21 @@ Strategy make_strategy(const std::string& spec, detect::Backend backend, int thr
     detect::TopDownOptions o;
     if (parts[1] != "lightning" && parts[1] != "thunder")
       throw std::invalid_argument(
-          "topdown:lightning|thunder:EVERY[:WORKERS[:THREADS]][:tTILES][:sSCORE][:kEVERY], got " +
+          "topdown:lightning|thunder:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:kEVERY][:"
+          "uSURE], got " +
           spec);
     o.pose_model = parts[1] == "thunder" ? detect::SinglePoseModel::thunder
                                          : detect::SinglePoseModel::lightning;
     o.detect_every = std::stoi(parts[2]);
-    // Then WORKERS and THREADS, and anywhere tN (person detector on N tiles) and sX (its score
-    // threshold).
+    // Then WORKERS and THREADS, and anywhere tN (person detector on N tiles; tNw: and the whole
+    // frame), sX (its score threshold), kK (keypoint pass every K frames) and uX (sure_box_score).
     std::vector<std::string> numbers;
     for (std::size_t i = 3; i < parts.size(); ++i) {
-      if (parts[i].size() > 1 && parts[i][0] == 't')
+      if (parts[i].size() > 1 && parts[i][0] == 't') {
         o.detector_tiles = std::stoi(parts[i].substr(1));
+        o.detector_whole_frame = parts[i].back() == 'w';
+      } else if (parts[i].size() > 1 && parts[i][0] == 'u')
+        o.sure_box_score = std::stof(parts[i].substr(1));
       else if (parts[i].size() > 1 && parts[i][0] == 's')
         o.min_box_score = std::stof(parts[i].substr(1));
       else if (parts[i].size() > 1 && parts[i][0] == 'k')
@@ -118,7 +122,8 @@ Strategy make_strategy(const std::string& spec, detect::Backend backend, int thr
     }
     if (numbers.size() > 2)
       throw std::invalid_argument(
-          "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES][:sSCORE][:kEVERY], got " + spec);
+          "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:kEVERY][:uSURE], got " +
+          spec);
     o.backend = backend;
     o.threads = numbers.size() == 2 ? std::stoi(numbers[1]) : threads;
     o.workers = numbers.empty() ? 1 : std::stoi(numbers[0]);
@@ -132,7 +137,7 @@ Strategy make_strategy(const std::string& spec, detect::Backend backend, int thr
   throw std::invalid_argument(
       "unknown strategy '" + spec +
       "' (multipose:SIZE, tiles:CxR:TILE:FRAME, "
-      "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES][:sSCORE][:kEVERY])");
+      "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:kEVERY][:uSURE])");
 }
 
 // Every frame of a video, or the one image of a still.
@@ -321,7 +326,8 @@ void diagnose(const std::string& input, const eval::DetectionTruth& truth, const
   detect::CenternetNetwork network(detect::cached_model_json("centernet"), ro);
   detect::SinglePoseNetwork pose(o.pose_model,
                                  detect::cached_model_json(detect::model_name(o.pose_model)), ro);
-  const detect::ProposalOptions used{o.min_box_score, o.box_overlap, o.detector_tiles};
+  const detect::ProposalOptions used{o.min_box_score, o.box_overlap, o.detector_tiles,
+                                     o.detector_whole_frame};
   detect::GraphTensor scratch, crop;
   int alone_truths = 0, alone_counted = 0, alone_matched = 0;  // the proposals as the boxes
   detect::ProposalOptions low = used;
@@ -395,8 +401,14 @@ void diagnose(const std::string& input, const eval::DetectionTruth& truth, const
           points[j] = {region.cx - region.side / 2 + x * region.side,
                        region.cy - region.side / 2 + y * region.side, c};
         }
-        if (passing < o.min_keypoints || sum / std::max(1, passing) < o.min_person_score)
+        // A sure box is a person whatever its keypoints (TopDownOptions::sure_box_score).
+        const bool sure = o.sure_box_score > 0 && above->score >= o.sure_box_score;
+        const bool posed =
+            passing >= o.min_keypoints && sum / std::max(1, passing) >= o.min_person_score;
+        if (!posed && !sure)
           causes["(c1) proposed, crop's keypoints rejected"]++;
+        else if (!posed)
+          causes["(c3) proposed, person dropped (duplicate) or not looked for"]++;
         else if (detect::iou(detect::keypoint_box(points, 0.12f), box) < 0.3f)
           causes["(c2) proposed, crop's keypoints on someone else"]++;
         else
@@ -466,9 +478,12 @@ int main(int argc, char** argv) {
               "the first (on the first runtime) is the reference for keypoint distances: "
               "multipose:SIZE, "
               "tiles:CxR:TILE:FRAME, "
-              "topdown:lightning|thunder:EVERY[:WORKERS[:THREADS]][:tTILES][:sSCORE][:kEVERY] "
+              "topdown:lightning|thunder:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:kEVERY][:"
+              "uSURE] "
               "(workers: copies of the keypoint network sharing a frame's crops; tTILES: person "
-              "detector tiles, sSCORE: its box score floor, kEVERY: keypoint pass every EVERY "
+              "detector tiles, tTILESw: and the whole frame, sSCORE: its box score floor, uSURE: "
+              "boxes scoring SURE are people whatever their keypoints, kEVERY: keypoint pass every "
+              "EVERY "
               "frames, optical flow between; a top-down "
               "strategy also prints where its time went)",
               "topdown:thunder:1,multipose:256,multipose:512,tiles:2x2:256:256,"

@@ -30,6 +30,14 @@ const std::vector<DetectorPreset>& detector_presets() {
        "detect.topdown",
        {{"pose_model", "thunder"}, {"detect_every", "10"}},
        "the same with MoveNet Thunder (256 px crops): better keypoints, slower"},
+      {"topdown-tiles",
+       "detect.topdown",
+       {{"pose_model", "lightning"},
+        {"detect_every", "10"},
+        {"detector_tiles", "2"},
+        {"detector_whole_frame", "true"}},
+       "topdown with CenterNet on 2 square tiles plus the whole frame (wide frames: more small "
+       "people proposed, at a lower precision; docs/detection-strategies.md)"},
   };
   return presets;
 }

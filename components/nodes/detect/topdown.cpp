@@ -34,6 +34,13 @@ class TopDownNode : public Node {
                  "person detector on the whole frame stretched (1) or on N square tiles of a "
                  "wide frame, people keeping their shape",
                  {1, 8});
+    c.param<bool>("detector_whole_frame", false,
+                  "with detector_tiles > 1, one more detector pass on the whole frame for people "
+                  "wider than the tiles' overlap (close-ups), merged by NMS");
+    c.param<double>("sure_box_score", 0.0,
+                    "a person box the detector scores this high is a person even when the crop's "
+                    "keypoints fail the person test (only the confident keypoints kept); 0: off",
+                    {0.0, 1.0});
     c.param<double>("min_person_score", 0.35,
                     "a crop whose passing keypoints score less on average shows nobody",
                     {0.0, 1.0});
@@ -68,6 +75,8 @@ class TopDownNode : public Node {
     o.detect_every = ctx.param<int>("detect_every");
     o.min_box_score = ctx.param<float>("min_box_score");
     o.detector_tiles = ctx.param<int>("detector_tiles");
+    o.detector_whole_frame = ctx.param<bool>("detector_whole_frame");
+    o.sure_box_score = ctx.param<float>("sure_box_score");
     o.min_person_score = ctx.param<float>("min_person_score");
     o.min_keypoints = ctx.param<int>("min_keypoints");
     o.min_keypoint_score = ctx.param<float>("min_keypoint_score");
