@@ -4,20 +4,6 @@
 
 namespace mocap::eval {
 
-camera::Camera camera_of(const SceneCamera& c, const std::string& name) {
-  camera::Camera camera;
-  camera.name = name;
-  camera.width = c.width;
-  camera.height = c.height;
-  camera.fx = c.K[0][0];
-  camera.fy = c.K[1][1];
-  camera.cx = c.K[2][0];
-  camera.cy = c.K[2][1];
-  camera.rotation = c.R;
-  camera.translation = c.t;
-  return camera;
-}
-
 ShiftedViews shifted_views(const ScenePerson& person, const std::vector<SceneCamera>& cameras,
                            const std::vector<int>& starts, const std::vector<int>& phases,
                            int steps, int frames, const SceneDegradation& degradation,
@@ -25,8 +11,7 @@ ShiftedViews shifted_views(const ScenePerson& person, const std::vector<SceneCam
   if (starts.size() != phases.size() || starts.size() > cameras.size())
     throw std::invalid_argument("shifted_views: one start and phase per view, a camera each");
   ShiftedViews out;
-  for (std::size_t c = 0; c < cameras.size(); ++c)
-    out.cameras.push_back(camera_of(cameras[c], "cam_" + std::to_string(c + 1)));
+  out.cameras = scene_cameras(cameras);
   SceneRenderer renderer(cameras, seed);
   out.views.resize(starts.size());
   for (std::size_t v = 0; v < starts.size(); ++v) {

@@ -11,9 +11,6 @@
 
 namespace mocap::eval {
 
-// The scene camera as the one camera model (no distortion).
-camera::Camera camera_of(const SceneCamera& camera, const std::string& name);
-
 struct ShiftedViews {
   std::vector<camera::Camera> cameras;      // one per scene camera
   std::vector<camera::BodySequence> views;  // one per start

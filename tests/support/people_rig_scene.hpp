@@ -32,20 +32,6 @@ struct PeopleRigScene {
   std::vector<std::vector<std::vector<int>>> who;        // per camera, frame, detection: its person
 };
 
-inline camera::Camera camera_of(const eval::SceneCamera& c, int index) {
-  camera::Camera camera;
-  camera.name = std::string("cam_0") + std::to_string(index + 1);
-  camera.width = c.width;
-  camera.height = c.height;
-  camera.fx = c.K[0][0];
-  camera.fy = c.K[1][1];
-  camera.cx = c.K[2][0];
-  camera.cy = c.K[2][1];
-  camera.rotation = c.R;
-  camera.translation = c.t;
-  return camera;
-}
-
 // `frames` frames of `people` (placed already) seen by `cameras` cameras on a 4.5 m ring, 1.6 /
 // 2.4 m high, looking at the room's centre, 1920x1080 at 60 degrees.
 inline PeopleRigScene make_people_rig_scene(const std::vector<eval::ScenePerson>& people,
@@ -54,8 +40,7 @@ inline PeopleRigScene make_people_rig_scene(const std::vector<eval::ScenePerson>
                                             std::uint64_t seed) {
   const auto ring = eval::ring_rig(cameras, 4.5, 1.6, 0.8, {0.0, 1.0, 0.0}, eval::Image{});
   PeopleRigScene s;
-  for (std::size_t k = 0; k < ring.size(); ++k)
-    s.truth.push_back(camera_of(ring[k], static_cast<int>(k)));
+  s.truth = eval::scene_cameras(ring);
   eval::SceneRenderer renderer(ring, seed);
   s.views.resize(ring.size());
   s.who.resize(ring.size());
