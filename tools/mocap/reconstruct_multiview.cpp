@@ -218,9 +218,9 @@ std::string graph_text(const std::vector<View>& views, const std::string& rig_fi
 // frame i + offset), given as numbers or estimated from the keypoints of JSON views (auto).
 // Estimates keep their fraction in the summary; the views are moved by whole frames, shifted so
 // that the earliest view starts at frame 0.
-void apply_offsets(std::vector<View>& views, const camera::Rig& rig, const std::string& given) {
+void apply_offsets(std::vector<View>& views, const camera::Rig& rig, const Args& args) {
   std::vector<double> offsets;
-  if (given == "auto") {
+  if (args.get("offsets") == "auto") {
     std::vector<std::string> folders;
     for (const View& v : views) {
       if (v.kind != ViewKind::openpose_json)
@@ -247,14 +247,7 @@ void apply_offsets(std::vector<View>& views, const camera::Rig& rig, const std::
                   << " (contrast " << o.contrast << ")\n";
     }
   } else {
-    std::stringstream list(given);
-    for (std::string item; std::getline(list, item, ',');) {
-      char* end = nullptr;
-      const double value = std::strtod(item.c_str(), &end);
-      if (item.empty() || *end != '\0' || !std::isfinite(value) || std::abs(value) > 1e6)
-        throw InputError("--offsets", "'" + item + "' is not a number of frames");
-      offsets.push_back(value);
-    }
+    offsets = args.numbers("offsets");
     if (offsets.size() != views.size())
       throw InputError("--offsets", std::to_string(offsets.size()) + " offsets for " +
                                         std::to_string(views.size()) +
@@ -327,7 +320,13 @@ int reconstruct_multiview_command(int argc, char** argv) {
               "views filmed without a common clock: per view the frames it is shifted by (its "
               "frame i shows the first view's frame i + N), or auto: estimated from the people "
               "in OpenPose JSON views (docs/cameras.md, \"Frame offsets\"); applied to the "
-              "nearest frame")
+              "nearest frame",
+              std::nullopt,
+              [] {
+                Range frames = Range::between(-1e6, 1e6);
+                frames.list = true;
+                return frames.or_word("auto");
+              }())
       .option("set", "NODE.PARAM=VALUE",
               "override a node parameter of the graph (e.g. solve.volume=x0,y0,z0,x1,y1,z1)",
               std::nullopt, true)
@@ -365,7 +364,7 @@ int reconstruct_multiview_command(int argc, char** argv) {
   }
   check_frame_rates(views);
   if (fps <= 0.0) fps = 30.0;
-  if (args.has("offsets")) apply_offsets(views, rig, args.get("offsets"));
+  if (args.has("offsets")) apply_offsets(views, rig, args);
   std::string floor_how;
   const GroundPlane floor = multiview::rig_floor(rig, &floor_how);
   // TRC files are Y-up (OpenSim): a world whose floor is level in x-y (Pose2Sim's, a board's) is
