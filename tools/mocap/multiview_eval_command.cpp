@@ -215,6 +215,8 @@ int pose2sim_eval_command(int argc, char** argv) {
               {"reference", c.reference},
               {"frames", c.frames},
               {"trc_limb_std_mm", 1000 * eval::limb_std_m(c.trc_limb_lengths)},
+              {"trc_hip_width_median_mm", 1000 * eval::median_of(c.trc_hip_width_m)},
+              {"cameras", c.cameras},
               {"runs", json::array()}};
   const auto number = [](float v) { return std::isfinite(v) ? json(v) : json(nullptr); };
   for (const auto& r : c.runs) {
@@ -222,6 +224,8 @@ int pose2sim_eval_command(int argc, char** argv) {
                 {"frames_with_participant", r.frames_with_participant},
                 {"other_people", r.other_people},
                 {"limb_std_mm", number(1000 * eval::limb_std_m(r.limb_lengths))},
+                {"hip_width_median_mm", number(1000 * eval::median_of(r.hip_width_m))},
+                {"hip_width_std_mm", number(1000 * eval::limb_std_m({r.hip_width_m}))},
                 {"markers", json::object()}};
     for (std::size_t m = 0; m < c.markers.size(); ++m) {
       const auto& s = r.markers[m];
@@ -231,7 +235,10 @@ int pose2sim_eval_command(int argc, char** argv) {
           {"views_used", number(eval::mean_of(s.views))},
           {"error_used_px", number(eval::mean_of(s.error_used_px))},
           {"error_all_px", number(eval::mean_of(s.error_all_px))},
-          {"trc_error_all_px", number(eval::mean_of(s.trc_error_all_px))}};
+          {"trc_error_all_px", number(eval::mean_of(s.trc_error_all_px))},
+          {"views_left_out", s.left_out},
+          {"left_out_error_median_px", number(eval::median_of(s.left_out_error_px))},
+          {"from_triangulated_median_mm", number(1000 * eval::median_of(s.from_triangulated_m))}};
     }
     out["runs"].push_back(std::move(run));
   }
