@@ -160,5 +160,24 @@ TEST(Pose2SimComparison, TheHipsDifferByTheViewsNotByTheFit) {
   EXPECT_LT(limb_std_m({fitted.hip_width_m}), 0.001f);
 }
 
+// The control: in the static trial every view's hip agrees (the rule leaves none out), and there
+// the fitted hips are on the TRC's, BODY_25B's hip keypoints, within a centimetre.
+TEST(Pose2SimComparison, WhereTheRuleKeepsEveryViewTheFittedHipsAreTheTrcs) {
+  const std::string trial = "eval/pose2sim_demo/S00_P00_T00_StaticTrial";
+  MOCAP_REQUIRE_SHARED(trial);
+  MOCAP_REQUIRE_SHARED(kDemoCalibration);
+  const Pose2SimComparison c =
+      compare_with_pose2sim(test::shared_data() / trial, test::shared_data() / kDemoCalibration);
+  const Pose2SimRun &rule = c.runs[2], &fitted = c.runs[3];
+  ASSERT_TRUE(fitted.fitted);
+  EXPECT_GE(fitted.frames_with_participant, 8);
+  for (const char* marker : {"RHip", "LHip"}) {
+    const std::size_t m = marker_index(c, marker);
+    for (int n : rule.markers[m].left_out) EXPECT_EQ(n, 0) << marker;
+    ASSERT_FALSE(fitted.markers[m].distance_m.empty()) << marker;
+    EXPECT_LT(median_of(fitted.markers[m].distance_m), 0.01f) << marker;
+  }
+}
+
 }  // namespace
 }  // namespace mocap::eval
