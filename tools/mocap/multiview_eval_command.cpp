@@ -194,7 +194,9 @@ int pose2sim_eval_command(int argc, char** argv) {
             "Pose2Sim's demo (issue 19 report 1): our multi-view reconstruction of its BODY_25B "
             "JSON with its\ncalibration against Pose2Sim's own triangulated TRC, per marker: "
             "median and mean distance, views\nused, reprojection errors (ours and the TRC's), "
-            "limb-length std over the trial, with and\nwithout the skeleton fit on all views.");
+            "limb-length std over the trial, with and\nwithout the skeleton fit on all views; the "
+            "hip width, and per marker the views each\ntriangulation left out and how far the "
+            "fit moved the point.");
   args.option("trial", "DIR", "Pose2Sim trial folder (pose/camXX_json, pose-3d/*.trc)",
               "../shared/data/eval/pose2sim_demo/S00_P00_T01_BalancingTrial")
       .option("calibration", "FILE", "its calibration (Pose2Sim TOML)",
