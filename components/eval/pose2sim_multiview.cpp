@@ -52,57 +52,70 @@ std::filesystem::path raw_trc(const std::filesystem::path& trial) {
   throw InputError(folder.string(), "no raw triangulation TRC (*.trc without _filt) here");
 }
 
-struct Demo {
-  std::vector<camera::Camera> cameras;
-  GroundPlane floor;  // the rig's (Pose2Sim's world: z = 0)
-  std::vector<multiview::ViewGeometry> views;
-  std::vector<io::OpenPoseSequence> json;  // per camera, in folder name order
-  io::TrcFile trc;
-  std::size_t frames = 0;
+// The body joint that is keypoint k itself (not a midpoint), or -1: the markers a fitted body
+// (15 joints) can be compared on.
+int body_joint_of(const multiview::KeypointSet& set, int k) {
+  for (int j = 0; j < kBodyJoints; ++j)
+    if (set.body[j].first == k && set.body[j].second < 0) return j;
+  return -1;
+}
 
-  // Frame i's detections, undistorted with each camera's lens.
-  void observations(std::size_t i, multiview::FrameObservations& out) const {
-    out.reset(static_cast<int>(views.size()), 25);
-    std::vector<std::array<float, 2>> pixels;
-    for (std::size_t c = 0; c < views.size(); ++c) {
-      if (i >= json[c].frames.size()) continue;
-      for (const Person2D& person : json[c].frames[i].people) {
-        const std::span<float> xyc = out.add_person(static_cast<int>(c));
-        pixels.clear();
-        for (const Keypoint2D& k : person.joints) pixels.push_back({k.x, k.y});
-        cameras[c].undistort_pixels(pixels);
-        for (std::size_t k = 0; k < person.joints.size() && k < 25; ++k) {
-          xyc[3 * k] = pixels[k][0];
-          xyc[3 * k + 1] = pixels[k][1];
-          xyc[3 * k + 2] = person.joints[k].confidence;
-        }
+std::string fixed(double v, int digits) {
+  std::ostringstream s;
+  s << std::fixed << std::setprecision(digits) << v;
+  return s.str();
+}
+
+std::vector<float> finite_only(const std::vector<float>& v) {
+  std::vector<float> out;
+  for (float x : v)
+    if (std::isfinite(x)) out.push_back(x);
+  return out;
+}
+
+}  // namespace
+
+void Pose2SimDemo::observations(std::size_t i, multiview::FrameObservations& out) const {
+  out.reset(static_cast<int>(views.size()), 25);
+  std::vector<std::array<float, 2>> pixels;
+  for (std::size_t c = 0; c < views.size(); ++c) {
+    if (i >= json[c].frames.size()) continue;
+    for (const Person2D& person : json[c].frames[i].people) {
+      const std::span<float> xyc = out.add_person(static_cast<int>(c));
+      pixels.clear();
+      for (const Keypoint2D& k : person.joints) pixels.push_back({k.x, k.y});
+      cameras[c].undistort_pixels(pixels);
+      for (std::size_t k = 0; k < person.joints.size() && k < 25; ++k) {
+        xyc[3 * k] = pixels[k][0];
+        xyc[3 * k + 1] = pixels[k][1];
+        xyc[3 * k + 2] = person.joints[k].confidence;
       }
     }
   }
+}
 
-  // Mean distance of `world`'s projection to keypoint k of the participant's confident
-  // detections (raw pixels, so through the lens); NaN without one.
-  float error_all_px(std::size_t i, std::span<const int> detections, int k,
-                     const glm::dvec3& world) const {
-    double sum = 0.0;
-    int n = 0;
-    for (std::size_t c = 0; c < detections.size(); ++c) {
-      if (detections[c] < 0) continue;
-      const Keypoint2D& kp =
-          json[c].frames[i].people[static_cast<std::size_t>(detections[c])].joints[k];
-      if (kp.confidence < kLikelihoodThreshold) continue;
-      const glm::dvec2 p = cameras[c].project(world);
-      if (!std::isfinite(p.x)) continue;
-      sum += glm::distance(p, glm::dvec2(kp.x, kp.y));
-      ++n;
-    }
-    return n > 0 ? static_cast<float>(sum / n) : std::nanf("");
+float Pose2SimDemo::error_all_px(std::size_t i, std::span<const int> detections, int k,
+                                 const glm::dvec3& world) const {
+  double sum = 0.0;
+  int n = 0;
+  for (std::size_t c = 0; c < detections.size(); ++c) {
+    if (detections[c] < 0) continue;
+    const Keypoint2D& kp =
+        json[c].frames[i].people[static_cast<std::size_t>(detections[c])].joints[k];
+    if (kp.confidence < kLikelihoodThreshold) continue;
+    const glm::dvec2 p = cameras[c].project(world);
+    if (!std::isfinite(p.x)) continue;
+    sum += glm::distance(p, glm::dvec2(kp.x, kp.y));
+    ++n;
   }
-};
+  return n > 0 ? static_cast<float>(sum / n) : std::nanf("");
+}
 
-Demo load(const std::filesystem::path& trial, const std::filesystem::path& calibration,
-          std::size_t max_frames) {
-  Demo d;
+Pose2SimDemo load_pose2sim_demo(const std::filesystem::path& trial,
+                                const std::filesystem::path& calibration, std::size_t max_frames) {
+  Pose2SimDemo d;
+  d.trial = trial.string();
+  d.calibration = calibration.string();
   const camera::Rig rig = camera::read_rig(calibration);
   d.cameras = rig.cameras;
   d.floor = multiview::rig_floor(rig);
@@ -129,24 +142,16 @@ Demo load(const std::filesystem::path& trial, const std::filesystem::path& calib
   return d;
 }
 
-// The body joint that is keypoint k itself (not a midpoint), or -1: the markers a fitted body
-// (15 joints) can be compared on.
-int body_joint_of(const multiview::KeypointSet& set, int k) {
-  for (int j = 0; j < kBodyJoints; ++j)
-    if (set.body[j].first == k && set.body[j].second < 0) return j;
-  return -1;
-}
-
-// One reconstruction of the demo (`fit`: + the skeleton fit on all views, full mode, over the
-// tracks, compared on the markers that are body joints).
-Pose2SimRun run(const Demo& demo, std::string name, const multiview::ReconstructionOptions& o,
-                bool fit = false) {
+Pose2SimRun run_pose2sim_demo(const Pose2SimDemo& demo, std::string name,
+                              const multiview::ReconstructionOptions& o, bool fit,
+                              const Pose2SimFrameObserver& observe) {
   multiview::ReconstructionOptions options = o;
   options.tracker.fps = static_cast<float>(demo.trc.rate);
   const multiview::KeypointSet set = multiview::KeypointSet::of(layout(LayoutId::body25b));
   multiview::MultiViewReconstructor reconstructor(demo.views, set, options);
   Pose2SimRun out;
   out.name = std::move(name);
+  out.fitted = fit;
   out.markers.resize(demo.trc.markers.size());
   out.limb_lengths.resize(pose2sim_limbs().size());
   const auto rhip = demo.trc.marker("RHip"), lhip = demo.trc.marker("LHip");
@@ -188,6 +193,7 @@ Pose2SimRun run(const Demo& demo, std::string name, const multiview::Reconstruct
       }
     }
     out.other_people += static_cast<int>(r.people.size()) - (participant >= 0);
+    if (observe) observe(i, r, participant);
     if (participant < 0) continue;
     ++out.frames_with_participant;
     const auto p = static_cast<std::size_t>(participant);
@@ -214,21 +220,6 @@ Pose2SimRun run(const Demo& demo, std::string name, const multiview::Reconstruct
   }
   return out;
 }
-
-std::string fixed(double v, int digits) {
-  std::ostringstream s;
-  s << std::fixed << std::setprecision(digits) << v;
-  return s.str();
-}
-
-std::vector<float> finite_only(const std::vector<float>& v) {
-  std::vector<float> out;
-  for (float x : v)
-    if (std::isfinite(x)) out.push_back(x);
-  return out;
-}
-
-}  // namespace
 
 float median_of(std::vector<float> v) {
   v = finite_only(v);
@@ -266,13 +257,24 @@ const std::vector<std::pair<std::string, std::string>>& pose2sim_limbs() {
   return limbs;
 }
 
-Pose2SimComparison compare_with_pose2sim(const std::filesystem::path& trial,
-                                         const std::filesystem::path& calibration,
-                                         std::size_t max_frames) {
-  const Demo demo = load(trial, calibration, max_frames);
+Pose2SimMarkerStats pooled(const Pose2SimRun& run) {
+  Pose2SimMarkerStats all;
+  for (const auto& m : run.markers) {
+    all.distance_m.insert(all.distance_m.end(), m.distance_m.begin(), m.distance_m.end());
+    all.views.insert(all.views.end(), m.views.begin(), m.views.end());
+    all.error_used_px.insert(all.error_used_px.end(), m.error_used_px.begin(),
+                             m.error_used_px.end());
+    all.error_all_px.insert(all.error_all_px.end(), m.error_all_px.begin(), m.error_all_px.end());
+    all.trc_error_all_px.insert(all.trc_error_all_px.end(), m.trc_error_all_px.begin(),
+                                m.trc_error_all_px.end());
+  }
+  return all;
+}
+
+Pose2SimComparison pose2sim_comparison(const Pose2SimDemo& demo) {
   Pose2SimComparison c;
-  c.trial = trial.string();
-  c.calibration = calibration.string();
+  c.trial = demo.trial;
+  c.calibration = demo.calibration;
   c.reference = demo.trc.path;
   c.frames = demo.frames;
   c.markers = demo.trc.markers;
@@ -286,14 +288,22 @@ Pose2SimComparison compare_with_pose2sim(const std::filesystem::path& trial,
             glm::distance(demo.trc.frames[i][*a], demo.trc.frames[i][*b]));
     }
   }
-  c.runs.push_back(run(demo, "ours", {}));
+  return c;
+}
+
+Pose2SimComparison compare_with_pose2sim(const std::filesystem::path& trial,
+                                         const std::filesystem::path& calibration,
+                                         std::size_t max_frames) {
+  const Pose2SimDemo demo = load_pose2sim_demo(trial, calibration, max_frames);
+  Pose2SimComparison c = pose2sim_comparison(demo);
+  c.runs.push_back(run_pose2sim_demo(demo, "ours", {}));
   multiview::ReconstructionOptions no_prior;
   no_prior.tracker.prior = false;
-  c.runs.push_back(run(demo, "ours without the tracks' prior", no_prior));
+  c.runs.push_back(run_pose2sim_demo(demo, "ours without the tracks' prior", no_prior));
   multiview::ReconstructionOptions rule;
   rule.triangulation.method = multiview::TriangulationMethod::pose2sim;
-  c.runs.push_back(run(demo, "Pose2Sim's rule (ours)", rule));
-  c.runs.push_back(run(demo, "ours + skeleton fit (full)", {}, true));
+  c.runs.push_back(run_pose2sim_demo(demo, "Pose2Sim's rule (ours)", rule));
+  c.runs.push_back(run_pose2sim_demo(demo, "ours + skeleton fit (full)", {}, true));
   return c;
 }
 
@@ -315,19 +325,7 @@ std::string pose2sim_table(const Pose2SimComparison& c) {
   };
   for (std::size_t m = 0; m < c.markers.size(); ++m)
     for (const Pose2SimRun& r : c.runs) row(c.markers[m], r, r.markers[m]);
-  for (const Pose2SimRun& r : c.runs) {
-    Pose2SimMarkerStats all;
-    for (const auto& m : r.markers) {
-      all.distance_m.insert(all.distance_m.end(), m.distance_m.begin(), m.distance_m.end());
-      all.views.insert(all.views.end(), m.views.begin(), m.views.end());
-      all.error_used_px.insert(all.error_used_px.end(), m.error_used_px.begin(),
-                               m.error_used_px.end());
-      all.error_all_px.insert(all.error_all_px.end(), m.error_all_px.begin(), m.error_all_px.end());
-      all.trc_error_all_px.insert(all.trc_error_all_px.end(), m.trc_error_all_px.begin(),
-                                  m.trc_error_all_px.end());
-    }
-    row("**all**", r, all);
-  }
+  for (const Pose2SimRun& r : c.runs) row("**all**", r, pooled(r));
   s << "\nLimb length std over the trial (mean of " << pose2sim_limbs().size() << " limbs), mm: ";
   for (const Pose2SimRun& r : c.runs)
     s << r.name << " " << fixed(1000 * limb_std_m(r.limb_lengths), 1) << ", ";
@@ -336,9 +334,11 @@ std::string pose2sim_table(const Pose2SimComparison& c) {
   for (const Pose2SimRun& r : c.runs)
     s << r.name << " " << r.frames_with_participant << " (other people reported " << r.other_people
       << "); ";
-  s << "\n\nWith skeleton fitting: the fitted 15 body joints, compared on the markers that "
-       "are body joints in BODY_25B's mapping (all 14 here: Neck is UpperNeck, Head HeadTop); "
-       "\"views used\" counts the person's views, the fit uses every one of them.\n";
+  s << "\n";
+  if (std::any_of(c.runs.begin(), c.runs.end(), [](const Pose2SimRun& r) { return r.fitted; }))
+    s << "\nWith skeleton fitting: the fitted 15 body joints, compared on the markers that are "
+         "body joints in BODY_25B's mapping (all 14 here: Neck is UpperNeck, Head HeadTop); "
+         "\"views used\" counts the person's views, the fit uses every one of them.\n";
   return s.str();
 }
 
