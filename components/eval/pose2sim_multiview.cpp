@@ -23,16 +23,6 @@ namespace {
 
 constexpr float kLikelihoodThreshold = 0.3f;  // Pose2Sim's, for the "all views" errors
 
-// The TRC's markers are BODY_25B keypoints of the same names, but for these two.
-int body25b_keypoint(const std::string& marker) {
-  if (marker == "Neck") return 17;  // UpperNeck
-  if (marker == "Head") return 18;  // HeadTop
-  const KeypointLayout& l = layout(LayoutId::body25b);
-  for (std::size_t k = 0; k < l.keypoints.size(); ++k)
-    if (l.keypoints[k] == marker) return static_cast<int>(k);
-  return -1;
-}
-
 glm::dmat3 intrinsic_matrix(const camera::Camera& c) {
   const std::array<double, 9> rows = c.matrix();
   glm::dmat3 k(1.0);  // GLM is column-major, Camera::matrix() row-major
@@ -122,17 +112,7 @@ Pose2SimDemo load_pose2sim_demo(const std::filesystem::path& trial,
   for (const auto& c : d.cameras)
     d.views.push_back(
         multiview::ViewGeometry::from_krt(intrinsic_matrix(c), c.rotation, c.translation));
-  std::vector<std::filesystem::path> folders;
-  std::error_code error;
-  for (const auto& entry : std::filesystem::directory_iterator(trial / "pose", error))
-    if (entry.is_directory() && entry.path().filename().string().ends_with("_json"))
-      folders.push_back(entry.path());
-  if (error) throw InputError((trial / "pose").string(), "cannot list: " + error.message());
-  std::sort(folders.begin(), folders.end());
-  if (folders.size() != d.cameras.size())
-    throw InputError((trial / "pose").string(),
-                     std::to_string(folders.size()) + " camXX_json folders for " +
-                         std::to_string(d.cameras.size()) + " cameras in " + calibration.string());
+  const auto folders = pose2sim_json_folders(trial, d.cameras.size(), calibration);
   io::OpenPoseOptions options;
   options.body25 = io::Body25Choice::body25b;
   for (const auto& f : folders) d.json.push_back(io::read_openpose_folder(f, options));
@@ -199,13 +179,13 @@ Pose2SimRun run_pose2sim_demo(const Pose2SimDemo& demo, std::string name,
     const auto p = static_cast<std::size_t>(participant);
     const auto detections = r.detections_of(p);
     for (std::size_t l = 0; l < pose2sim_limbs().size(); ++l) {
-      const auto* a = point(r, p, body25b_keypoint(pose2sim_limbs()[l].first));
-      const auto* b = point(r, p, body25b_keypoint(pose2sim_limbs()[l].second));
+      const auto* a = point(r, p, pose2sim_marker_keypoint(pose2sim_limbs()[l].first));
+      const auto* b = point(r, p, pose2sim_marker_keypoint(pose2sim_limbs()[l].second));
       if (a && b && a->valid() && b->valid())
         out.limb_lengths[l].push_back(glm::distance(a->position, b->position));
     }
     for (std::size_t m = 0; m < demo.trc.markers.size(); ++m) {
-      const int k = body25b_keypoint(demo.trc.markers[m]);
+      const int k = pose2sim_marker_keypoint(demo.trc.markers[m]);
       const multiview::TriangulatedPoint* ours = point(r, p, k);
       if (!ours || !ours->valid()) continue;
       const glm::dvec3 theirs = trc_to_world(demo.trc.frames[i][m]);
