@@ -23,16 +23,6 @@ namespace {
 
 constexpr float kLikelihoodThreshold = 0.3f;  // Pose2Sim's, for the "all views" errors
 
-// The TRC's markers are BODY_25B keypoints of the same names, but for these two.
-int body25b_keypoint(const std::string& marker) {
-  if (marker == "Neck") return 17;  // UpperNeck
-  if (marker == "Head") return 18;  // HeadTop
-  const KeypointLayout& l = layout(LayoutId::body25b);
-  for (std::size_t k = 0; k < l.keypoints.size(); ++k)
-    if (l.keypoints[k] == marker) return static_cast<int>(k);
-  return -1;
-}
-
 glm::dmat3 intrinsic_matrix(const camera::Camera& c) {
   const std::array<double, 9> rows = c.matrix();
   glm::dmat3 k(1.0);  // GLM is column-major, Camera::matrix() row-major
@@ -52,87 +42,89 @@ std::filesystem::path raw_trc(const std::filesystem::path& trial) {
   throw InputError(folder.string(), "no raw triangulation TRC (*.trc without _filt) here");
 }
 
-struct Demo {
-  std::vector<camera::Camera> cameras;
-  GroundPlane floor;  // the rig's (Pose2Sim's world: z = 0)
-  std::vector<multiview::ViewGeometry> views;
-  std::vector<io::OpenPoseSequence> json;  // per camera, in folder name order
-  io::TrcFile trc;
-  std::size_t frames = 0;
+// The body joint that is keypoint k itself (not a midpoint), or -1: the markers a fitted body
+// (15 joints) can be compared on.
+int body_joint_of(const multiview::KeypointSet& set, int k) {
+  for (int j = 0; j < kBodyJoints; ++j)
+    if (set.body[j].first == k && set.body[j].second < 0) return j;
+  return -1;
+}
 
-  // Frame i's detections, undistorted with each camera's lens.
-  void observations(std::size_t i, multiview::FrameObservations& out) const {
-    out.reset(static_cast<int>(views.size()), 25);
-    std::vector<std::array<float, 2>> pixels;
-    for (std::size_t c = 0; c < views.size(); ++c) {
-      if (i >= json[c].frames.size()) continue;
-      for (const Person2D& person : json[c].frames[i].people) {
-        const std::span<float> xyc = out.add_person(static_cast<int>(c));
-        pixels.clear();
-        for (const Keypoint2D& k : person.joints) pixels.push_back({k.x, k.y});
-        cameras[c].undistort_pixels(pixels);
-        for (std::size_t k = 0; k < person.joints.size() && k < 25; ++k) {
-          xyc[3 * k] = pixels[k][0];
-          xyc[3 * k + 1] = pixels[k][1];
-          xyc[3 * k + 2] = person.joints[k].confidence;
-        }
+std::string fixed(double v, int digits) {
+  std::ostringstream s;
+  s << std::fixed << std::setprecision(digits) << v;
+  return s.str();
+}
+
+std::vector<float> finite_only(const std::vector<float>& v) {
+  std::vector<float> out;
+  for (float x : v)
+    if (std::isfinite(x)) out.push_back(x);
+  return out;
+}
+
+}  // namespace
+
+void Pose2SimDemo::observations(std::size_t i, multiview::FrameObservations& out) const {
+  out.reset(static_cast<int>(views.size()), 25);
+  std::vector<std::array<float, 2>> pixels;
+  for (std::size_t c = 0; c < views.size(); ++c) {
+    if (i >= json[c].frames.size()) continue;
+    for (const Person2D& person : json[c].frames[i].people) {
+      const std::span<float> xyc = out.add_person(static_cast<int>(c));
+      pixels.clear();
+      for (const Keypoint2D& k : person.joints) pixels.push_back({k.x, k.y});
+      cameras[c].undistort_pixels(pixels);
+      for (std::size_t k = 0; k < person.joints.size() && k < 25; ++k) {
+        xyc[3 * k] = pixels[k][0];
+        xyc[3 * k + 1] = pixels[k][1];
+        xyc[3 * k + 2] = person.joints[k].confidence;
       }
     }
   }
+}
 
-  // Whether camera c's detection d (-1: none) has keypoint k at Pose2Sim's likelihood threshold.
-  bool confident(std::size_t i, std::size_t c, int d, int k) const {
-    if (d < 0) return false;
-    return json[c]
-               .frames[i]
-               .people[static_cast<std::size_t>(d)]
-               .joints[static_cast<std::size_t>(k)]
-               .confidence >= kLikelihoodThreshold;
+bool Pose2SimDemo::confident(std::size_t i, std::size_t c, int d, int k) const {
+  if (d < 0) return false;
+  return json[c]
+             .frames[i]
+             .people[static_cast<std::size_t>(d)]
+             .joints[static_cast<std::size_t>(k)]
+             .confidence >= kLikelihoodThreshold;
+}
+
+float Pose2SimDemo::error_px(std::size_t i, std::size_t c, int d, int k,
+                             const glm::dvec3& world) const {
+  if (!confident(i, c, d, k)) return std::nanf("");
+  const Keypoint2D& kp = json[c].frames[i].people[static_cast<std::size_t>(d)].joints[k];
+  const glm::dvec2 p = cameras[c].project(world);
+  return std::isfinite(p.x) ? static_cast<float>(glm::distance(p, glm::dvec2(kp.x, kp.y)))
+                            : std::nanf("");
+}
+
+float Pose2SimDemo::error_all_px(std::size_t i, std::span<const int> detections, int k,
+                                 const glm::dvec3& world) const {
+  double sum = 0.0;
+  int n = 0;
+  for (std::size_t c = 0; c < detections.size(); ++c) {
+    const float e = error_px(i, c, detections[c], k, world);
+    if (std::isfinite(e)) sum += e, ++n;
   }
+  return n > 0 ? static_cast<float>(sum / n) : std::nanf("");
+}
 
-  // Distance of `world`'s projection through camera c to keypoint k of its detection d (raw
-  // pixels, so through the lens); NaN when it is not confident or does not project.
-  float error_px(std::size_t i, std::size_t c, int d, int k, const glm::dvec3& world) const {
-    if (!confident(i, c, d, k)) return std::nanf("");
-    const Keypoint2D& kp = json[c].frames[i].people[static_cast<std::size_t>(d)].joints[k];
-    const glm::dvec2 p = cameras[c].project(world);
-    return std::isfinite(p.x) ? static_cast<float>(glm::distance(p, glm::dvec2(kp.x, kp.y)))
-                              : std::nanf("");
-  }
-
-  // Mean of error_px over the participant's detections; NaN without one.
-  float error_all_px(std::size_t i, std::span<const int> detections, int k,
-                     const glm::dvec3& world) const {
-    double sum = 0.0;
-    int n = 0;
-    for (std::size_t c = 0; c < detections.size(); ++c) {
-      const float e = error_px(i, c, detections[c], k, world);
-      if (std::isfinite(e)) sum += e, ++n;
-    }
-    return n > 0 ? static_cast<float>(sum / n) : std::nanf("");
-  }
-};
-
-Demo load(const std::filesystem::path& trial, const std::filesystem::path& calibration,
-          std::size_t max_frames) {
-  Demo d;
+Pose2SimDemo load_pose2sim_demo(const std::filesystem::path& trial,
+                                const std::filesystem::path& calibration, std::size_t max_frames) {
+  Pose2SimDemo d;
+  d.trial = trial.string();
+  d.calibration = calibration.string();
   const camera::Rig rig = camera::read_rig(calibration);
   d.cameras = rig.cameras;
   d.floor = multiview::rig_floor(rig);
   for (const auto& c : d.cameras)
     d.views.push_back(
         multiview::ViewGeometry::from_krt(intrinsic_matrix(c), c.rotation, c.translation));
-  std::vector<std::filesystem::path> folders;
-  std::error_code error;
-  for (const auto& entry : std::filesystem::directory_iterator(trial / "pose", error))
-    if (entry.is_directory() && entry.path().filename().string().ends_with("_json"))
-      folders.push_back(entry.path());
-  if (error) throw InputError((trial / "pose").string(), "cannot list: " + error.message());
-  std::sort(folders.begin(), folders.end());
-  if (folders.size() != d.cameras.size())
-    throw InputError((trial / "pose").string(),
-                     std::to_string(folders.size()) + " camXX_json folders for " +
-                         std::to_string(d.cameras.size()) + " cameras in " + calibration.string());
+  const auto folders = pose2sim_json_folders(trial, d.cameras.size(), calibration);
   io::OpenPoseOptions options;
   options.body25 = io::Body25Choice::body25b;
   for (const auto& f : folders) d.json.push_back(io::read_openpose_folder(f, options));
@@ -142,18 +134,9 @@ Demo load(const std::filesystem::path& trial, const std::filesystem::path& calib
   return d;
 }
 
-// The body joint that is keypoint k itself (not a midpoint), or -1: the markers a fitted body
-// (15 joints) can be compared on.
-int body_joint_of(const multiview::KeypointSet& set, int k) {
-  for (int j = 0; j < kBodyJoints; ++j)
-    if (set.body[j].first == k && set.body[j].second < 0) return j;
-  return -1;
-}
-
-// One reconstruction of the demo (`fit`: + the skeleton fit on all views, full mode, over the
-// tracks, compared on the markers that are body joints).
-Pose2SimRun run(const Demo& demo, std::string name, const multiview::ReconstructionOptions& o,
-                bool fit = false) {
+Pose2SimRun run_pose2sim_demo(const Pose2SimDemo& demo, std::string name,
+                              const multiview::ReconstructionOptions& o, bool fit,
+                              const Pose2SimFrameObserver& observe) {
   multiview::ReconstructionOptions options = o;
   options.tracker.fps = static_cast<float>(demo.trc.rate);
   const multiview::KeypointSet set = multiview::KeypointSet::of(layout(LayoutId::body25b));
@@ -205,22 +188,23 @@ Pose2SimRun run(const Demo& demo, std::string name, const multiview::Reconstruct
       }
     }
     out.other_people += static_cast<int>(r.people.size()) - (participant >= 0);
+    if (observe) observe(i, r, participant);
     if (participant < 0) continue;
     ++out.frames_with_participant;
     const auto p = static_cast<std::size_t>(participant);
     const auto detections = r.detections_of(p);
     for (std::size_t l = 0; l < pose2sim_limbs().size(); ++l) {
-      const auto* a = point(r, p, body25b_keypoint(pose2sim_limbs()[l].first));
-      const auto* b = point(r, p, body25b_keypoint(pose2sim_limbs()[l].second));
+      const auto* a = point(r, p, pose2sim_marker_keypoint(pose2sim_limbs()[l].first));
+      const auto* b = point(r, p, pose2sim_marker_keypoint(pose2sim_limbs()[l].second));
       if (a && b && a->valid() && b->valid())
         out.limb_lengths[l].push_back(glm::distance(a->position, b->position));
     }
-    const auto* right_hip = point(r, p, body25b_keypoint("RHip"));
-    const auto* left_hip = point(r, p, body25b_keypoint("LHip"));
+    const auto* right_hip = point(r, p, pose2sim_marker_keypoint("RHip"));
+    const auto* left_hip = point(r, p, pose2sim_marker_keypoint("LHip"));
     if (right_hip && left_hip && right_hip->valid() && left_hip->valid())
       out.hip_width_m.push_back(glm::distance(right_hip->position, left_hip->position));
     for (std::size_t m = 0; m < demo.trc.markers.size(); ++m) {
-      const int k = body25b_keypoint(demo.trc.markers[m]);
+      const int k = pose2sim_marker_keypoint(demo.trc.markers[m]);
       const multiview::TriangulatedPoint* ours = point(r, p, k);
       if (!ours || !ours->valid()) continue;
       Pose2SimMarkerStats& s = out.markers[m];
@@ -249,18 +233,7 @@ Pose2SimRun run(const Demo& demo, std::string name, const multiview::Reconstruct
   return out;
 }
 
-std::string fixed(double v, int digits) {
-  std::ostringstream s;
-  s << std::fixed << std::setprecision(digits) << v;
-  return s.str();
-}
-
-std::vector<float> finite_only(const std::vector<float>& v) {
-  std::vector<float> out;
-  for (float x : v)
-    if (std::isfinite(x)) out.push_back(x);
-  return out;
-}
+namespace {
 
 // "a/b/c": counts or names joined by slashes.
 template <class T>
@@ -345,13 +318,24 @@ const std::vector<std::pair<std::string, std::string>>& pose2sim_limbs() {
   return limbs;
 }
 
-Pose2SimComparison compare_with_pose2sim(const std::filesystem::path& trial,
-                                         const std::filesystem::path& calibration,
-                                         std::size_t max_frames) {
-  const Demo demo = load(trial, calibration, max_frames);
+Pose2SimMarkerStats pooled(const Pose2SimRun& run) {
+  Pose2SimMarkerStats all;
+  for (const auto& m : run.markers) {
+    all.distance_m.insert(all.distance_m.end(), m.distance_m.begin(), m.distance_m.end());
+    all.views.insert(all.views.end(), m.views.begin(), m.views.end());
+    all.error_used_px.insert(all.error_used_px.end(), m.error_used_px.begin(),
+                             m.error_used_px.end());
+    all.error_all_px.insert(all.error_all_px.end(), m.error_all_px.begin(), m.error_all_px.end());
+    all.trc_error_all_px.insert(all.trc_error_all_px.end(), m.trc_error_all_px.begin(),
+                                m.trc_error_all_px.end());
+  }
+  return all;
+}
+
+Pose2SimComparison pose2sim_comparison(const Pose2SimDemo& demo) {
   Pose2SimComparison c;
-  c.trial = trial.string();
-  c.calibration = calibration.string();
+  c.trial = demo.trial;
+  c.calibration = demo.calibration;
   c.reference = demo.trc.path;
   c.frames = demo.frames;
   c.markers = demo.trc.markers;
@@ -370,14 +354,22 @@ Pose2SimComparison compare_with_pose2sim(const std::filesystem::path& trial,
             glm::distance(demo.trc.frames[i][*a], demo.trc.frames[i][*b]));
     }
   }
-  c.runs.push_back(run(demo, "ours", {}));
+  return c;
+}
+
+Pose2SimComparison compare_with_pose2sim(const std::filesystem::path& trial,
+                                         const std::filesystem::path& calibration,
+                                         std::size_t max_frames) {
+  const Pose2SimDemo demo = load_pose2sim_demo(trial, calibration, max_frames);
+  Pose2SimComparison c = pose2sim_comparison(demo);
+  c.runs.push_back(run_pose2sim_demo(demo, "ours", {}));
   multiview::ReconstructionOptions no_prior;
   no_prior.tracker.prior = false;
-  c.runs.push_back(run(demo, "ours without the tracks' prior", no_prior));
+  c.runs.push_back(run_pose2sim_demo(demo, "ours without the tracks' prior", no_prior));
   multiview::ReconstructionOptions rule;
   rule.triangulation.method = multiview::TriangulationMethod::pose2sim;
-  c.runs.push_back(run(demo, "Pose2Sim's rule (ours)", rule));
-  c.runs.push_back(run(demo, "ours + skeleton fit (full)", {}, true));
+  c.runs.push_back(run_pose2sim_demo(demo, "Pose2Sim's rule (ours)", rule));
+  c.runs.push_back(run_pose2sim_demo(demo, "ours + skeleton fit (full)", {}, true));
   return c;
 }
 
@@ -399,19 +391,7 @@ std::string pose2sim_table(const Pose2SimComparison& c) {
   };
   for (std::size_t m = 0; m < c.markers.size(); ++m)
     for (const Pose2SimRun& r : c.runs) row(c.markers[m], r, r.markers[m]);
-  for (const Pose2SimRun& r : c.runs) {
-    Pose2SimMarkerStats all;
-    for (const auto& m : r.markers) {
-      all.distance_m.insert(all.distance_m.end(), m.distance_m.begin(), m.distance_m.end());
-      all.views.insert(all.views.end(), m.views.begin(), m.views.end());
-      all.error_used_px.insert(all.error_used_px.end(), m.error_used_px.begin(),
-                               m.error_used_px.end());
-      all.error_all_px.insert(all.error_all_px.end(), m.error_all_px.begin(), m.error_all_px.end());
-      all.trc_error_all_px.insert(all.trc_error_all_px.end(), m.trc_error_all_px.begin(),
-                                  m.trc_error_all_px.end());
-    }
-    row("**all**", r, all);
-  }
+  for (const Pose2SimRun& r : c.runs) row("**all**", r, pooled(r));
   s << "\nLimb length std over the trial (mean of " << pose2sim_limbs().size() << " limbs), mm: ";
   for (const Pose2SimRun& r : c.runs)
     s << r.name << " " << fixed(1000 * limb_std_m(r.limb_lengths), 1) << ", ";
@@ -427,9 +407,11 @@ std::string pose2sim_table(const Pose2SimComparison& c) {
   for (const Pose2SimRun& r : c.runs)
     s << r.name << " " << r.frames_with_participant << " (other people reported " << r.other_people
       << "); ";
-  s << "\n\nWith skeleton fitting: the fitted 15 body joints, compared on the markers that "
-       "are body joints in BODY_25B's mapping (all 14 here: Neck is UpperNeck, Head HeadTop); "
-       "\"views used\" counts the person's views, the fit uses every one of them.\n";
+  s << "\n";
+  if (std::any_of(c.runs.begin(), c.runs.end(), [](const Pose2SimRun& r) { return r.fitted; }))
+    s << "\nWith skeleton fitting: the fitted 15 body joints, compared on the markers that are "
+         "body joints in BODY_25B's mapping (all 14 here: Neck is UpperNeck, Head HeadTop); "
+         "\"views used\" counts the person's views, the fit uses every one of them.\n";
   return s.str();
 }
 

@@ -102,21 +102,14 @@ TEST(Pose2SimComparison, FewFramesMatchItsTrc) {
   ASSERT_EQ(c.runs.size(), 4u);
   for (const Pose2SimRun& r : c.runs) {
     EXPECT_GE(r.frames_with_participant, 10) << r.name;
-    std::vector<float> all, trc_px;
-    for (const auto& m : r.markers) {
-      all.insert(all.end(), m.distance_m.begin(), m.distance_m.end());
-      trc_px.insert(trc_px.end(), m.trc_error_all_px.begin(), m.trc_error_all_px.end());
-    }
-    EXPECT_LT(median_of(all), 0.03f) << r.name;  // same JSON, same calibration
+    const Pose2SimMarkerStats all = pooled(r);
+    EXPECT_LT(median_of(all.distance_m), 0.03f) << r.name;  // same JSON, same calibration
     // The README's check: the TRC reprojects about 10 px from the detections.
-    EXPECT_GT(mean_of(trc_px), 3.0f);
-    EXPECT_LT(mean_of(trc_px), 25.0f);
+    EXPECT_GT(mean_of(all.trc_error_all_px), 3.0f);
+    EXPECT_LT(mean_of(all.trc_error_all_px), 25.0f);
   }
   // Our implementation of Pose2Sim's rule is Pose2Sim's triangulation (lens and gaps aside).
-  std::vector<float> rule;
-  for (const auto& m : c.runs[2].markers)
-    rule.insert(rule.end(), m.distance_m.begin(), m.distance_m.end());
-  EXPECT_LT(median_of(rule), 0.002f);
+  EXPECT_LT(median_of(pooled(c.runs[2]).distance_m), 0.002f);
   EXPECT_NE(pose2sim_table(c).find("| RHip | ours |"), std::string::npos);
   // With the fit: the markers that are body joints (not Neck and Head), constant limbs.
   const Pose2SimRun& fitted = c.runs[3];
