@@ -157,7 +157,8 @@ TEST(PeopleCalibration, TheWalkersStandingHeightGivesTheTrueScale) {
       test::make_people_rig_scene({walking_through_the_room(60)}, 3, 60, detector_like(), 13);
   PeopleCalibrationOptions options;
   options.height_m = stature;
-  options.max_frames = 30;  // of the 60 in each bundle adjustment: a fast test
+  options.max_frames = 30;     // of the 60 in each bundle adjustment: a fast test
+  options.outlier_rounds = 1;  // one re-solve after dropping outliers: a fast test
   const PeopleCalibration found =
       calibrate_rig_from_people(intrinsics_only(s.truth), s.views, sources(3), options);
   const test::RigComparison c = test::compare_rigs(found.rig.cameras, s.truth);
@@ -189,7 +190,8 @@ TEST(PeopleCalibration, TwoPeopleInViewAreAssociatedAcrossTheViews) {
   for (const auto& frame : s.views[0]) frames_with_two += frame.size() >= 2;
   EXPECT_GT(frames_with_two, 30);
   PeopleCalibrationOptions options;
-  options.max_frames = 30;  // of the 60 in each bundle adjustment: a fast test
+  options.max_frames = 30;     // of the 60 in each bundle adjustment: a fast test
+  options.outlier_rounds = 1;  // one re-solve after dropping outliers: a fast test
   const PeopleCalibration found =
       calibrate_rig_from_people(intrinsics_only(s.truth), s.views, sources(3), options);
   bool associated = false;
