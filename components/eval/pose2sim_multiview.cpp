@@ -80,21 +80,34 @@ struct Demo {
     }
   }
 
-  // Mean distance of `world`'s projection to keypoint k of the participant's confident
-  // detections (raw pixels, so through the lens); NaN without one.
+  // Whether camera c's detection d (-1: none) has keypoint k at Pose2Sim's likelihood threshold.
+  bool confident(std::size_t i, std::size_t c, int d, int k) const {
+    if (d < 0) return false;
+    return json[c]
+               .frames[i]
+               .people[static_cast<std::size_t>(d)]
+               .joints[static_cast<std::size_t>(k)]
+               .confidence >= kLikelihoodThreshold;
+  }
+
+  // Distance of `world`'s projection through camera c to keypoint k of its detection d (raw
+  // pixels, so through the lens); NaN when it is not confident or does not project.
+  float error_px(std::size_t i, std::size_t c, int d, int k, const glm::dvec3& world) const {
+    if (!confident(i, c, d, k)) return std::nanf("");
+    const Keypoint2D& kp = json[c].frames[i].people[static_cast<std::size_t>(d)].joints[k];
+    const glm::dvec2 p = cameras[c].project(world);
+    return std::isfinite(p.x) ? static_cast<float>(glm::distance(p, glm::dvec2(kp.x, kp.y)))
+                              : std::nanf("");
+  }
+
+  // Mean of error_px over the participant's detections; NaN without one.
   float error_all_px(std::size_t i, std::span<const int> detections, int k,
                      const glm::dvec3& world) const {
     double sum = 0.0;
     int n = 0;
     for (std::size_t c = 0; c < detections.size(); ++c) {
-      if (detections[c] < 0) continue;
-      const Keypoint2D& kp =
-          json[c].frames[i].people[static_cast<std::size_t>(detections[c])].joints[k];
-      if (kp.confidence < kLikelihoodThreshold) continue;
-      const glm::dvec2 p = cameras[c].project(world);
-      if (!std::isfinite(p.x)) continue;
-      sum += glm::distance(p, glm::dvec2(kp.x, kp.y));
-      ++n;
+      const float e = error_px(i, c, detections[c], k, world);
+      if (std::isfinite(e)) sum += e, ++n;
     }
     return n > 0 ? static_cast<float>(sum / n) : std::nanf("");
   }
@@ -147,7 +160,9 @@ Pose2SimRun run(const Demo& demo, std::string name, const multiview::Reconstruct
   multiview::MultiViewReconstructor reconstructor(demo.views, set, options);
   Pose2SimRun out;
   out.name = std::move(name);
+  out.fitted = fit;
   out.markers.resize(demo.trc.markers.size());
+  for (auto& m : out.markers) m.left_out.assign(demo.views.size(), 0);
   out.limb_lengths.resize(pose2sim_limbs().size());
   const auto rhip = demo.trc.marker("RHip"), lhip = demo.trc.marker("LHip");
   if (!rhip || !lhip) throw InputError(demo.trc.path, "no RHip and LHip markers");
@@ -157,7 +172,9 @@ Pose2SimRun run(const Demo& demo, std::string name, const multiview::Reconstruct
     demo.observations(i, observations[i]);
     results.push_back(reconstructor.process(observations[i], static_cast<std::int64_t>(i)));
   }
+  std::vector<multiview::FrameResult> triangulated;  // the fit's input, to measure its moves
   if (fit) {
+    triangulated = results;
     fit::MultiViewFitOptions f;
     f.cameras = demo.cameras;
     f.fit = fit::multiview_fit_defaults();
@@ -198,12 +215,29 @@ Pose2SimRun run(const Demo& demo, std::string name, const multiview::Reconstruct
       if (a && b && a->valid() && b->valid())
         out.limb_lengths[l].push_back(glm::distance(a->position, b->position));
     }
+    const auto* right_hip = point(r, p, body25b_keypoint("RHip"));
+    const auto* left_hip = point(r, p, body25b_keypoint("LHip"));
+    if (right_hip && left_hip && right_hip->valid() && left_hip->valid())
+      out.hip_width_m.push_back(glm::distance(right_hip->position, left_hip->position));
     for (std::size_t m = 0; m < demo.trc.markers.size(); ++m) {
       const int k = body25b_keypoint(demo.trc.markers[m]);
       const multiview::TriangulatedPoint* ours = point(r, p, k);
       if (!ours || !ours->valid()) continue;
-      const glm::dvec3 theirs = trc_to_world(demo.trc.frames[i][m]);
       Pose2SimMarkerStats& s = out.markers[m];
+      if (fit) {
+        const multiview::TriangulatedPoint& before =
+            triangulated[i].keypoints_of(p)[static_cast<std::size_t>(k)];
+        if (before.valid())
+          s.from_triangulated_m.push_back(glm::distance(ours->position, before.position));
+      } else {
+        for (std::size_t c = 0; c < detections.size(); ++c)
+          if (demo.confident(i, c, detections[c], k) && !(ours->views & (std::uint64_t{1} << c))) {
+            ++s.left_out[c];
+            s.left_out_error_px.push_back(
+                demo.error_px(i, c, detections[c], k, glm::dvec3(ours->position)));
+          }
+      }
+      const glm::dvec3 theirs = trc_to_world(demo.trc.frames[i][m]);
       s.trc_error_all_px.push_back(demo.error_all_px(i, detections, k, theirs));
       s.distance_m.push_back(glm::distance(ours->position, glm::vec3(theirs)));
       s.views.push_back(static_cast<float>(ours->view_count()));
@@ -226,6 +260,51 @@ std::vector<float> finite_only(const std::vector<float>& v) {
   for (float x : v)
     if (std::isfinite(x)) out.push_back(x);
   return out;
+}
+
+// "a/b/c": counts or names joined by slashes.
+template <class T>
+std::string joined(const std::vector<T>& items) {
+  std::ostringstream s;
+  for (std::size_t i = 0; i < items.size(); ++i) s << (i ? "/" : "") << items[i];
+  return s.str();
+}
+
+// Per marker: the frames in which each camera saw the keypoint (confidence >= 0.3) but a
+// triangulation left it out, and how far the fit moved the point from our triangulation.
+std::string views_left_out_table(const Pose2SimComparison& c) {
+  std::ostringstream s;
+  s << "\nViews left out: frames in which a camera saw the participant's keypoint (confidence >= "
+       "0.3) but the point was not triangulated from it, per camera ("
+    << joined(c.cameras)
+    << "; in brackets the median distance of the point's projection to the keypoints left out); "
+       "and how far the skeleton fit moved each point from our triangulation.\n\n"
+    << "| marker |";
+  for (const Pose2SimRun& r : c.runs)
+    if (!r.fitted) s << " " << r.name << " |";
+  s << " fit − ours triangulated, median mm |\n|---|";
+  for (const Pose2SimRun& r : c.runs)
+    if (!r.fitted) s << "---|";
+  s << "---:|\n";
+  for (std::size_t m = 0; m < c.markers.size(); ++m) {
+    s << "| " << c.markers[m] << " |";
+    std::vector<float> moved;
+    for (const Pose2SimRun& r : c.runs) {
+      const Pose2SimMarkerStats& stats = r.markers[m];
+      if (r.fitted) {
+        moved.insert(moved.end(), stats.from_triangulated_m.begin(),
+                     stats.from_triangulated_m.end());
+        continue;
+      }
+      const float error = median_of(stats.left_out_error_px);
+      s << " " << joined(stats.left_out);
+      if (std::isfinite(error)) s << " (" << fixed(error, 0) << " px)";
+      s << " |";
+    }
+    const float median = median_of(moved);
+    s << " " << (std::isfinite(median) ? fixed(1000 * median, 1) : "–") << " |\n";
+  }
+  return s.str();
 }
 
 }  // namespace
@@ -276,8 +355,13 @@ Pose2SimComparison compare_with_pose2sim(const std::filesystem::path& trial,
   c.reference = demo.trc.path;
   c.frames = demo.frames;
   c.markers = demo.trc.markers;
+  for (const auto& camera : demo.cameras) c.cameras.push_back(camera.name);
   c.trc_limb_lengths.resize(pose2sim_limbs().size());
+  const auto trc_rhip = demo.trc.marker("RHip"), trc_lhip = demo.trc.marker("LHip");
   for (std::size_t i = 0; i < demo.frames; ++i) {
+    if (trc_rhip && trc_lhip)
+      c.trc_hip_width_m.push_back(
+          glm::distance(demo.trc.frames[i][*trc_rhip], demo.trc.frames[i][*trc_lhip]));
     for (std::size_t l = 0; l < pose2sim_limbs().size(); ++l) {
       const auto a = demo.trc.marker(pose2sim_limbs()[l].first);
       const auto b = demo.trc.marker(pose2sim_limbs()[l].second);
@@ -332,6 +416,13 @@ std::string pose2sim_table(const Pose2SimComparison& c) {
   for (const Pose2SimRun& r : c.runs)
     s << r.name << " " << fixed(1000 * limb_std_m(r.limb_lengths), 1) << ", ";
   s << "Pose2Sim's TRC " << fixed(1000 * limb_std_m(c.trc_limb_lengths), 1) << "\n";
+  s << "\nHip width (RHip to LHip), median / std mm: ";
+  for (const Pose2SimRun& r : c.runs)
+    s << r.name << " " << fixed(1000 * median_of(r.hip_width_m), 0) << " / "
+      << fixed(1000 * limb_std_m({r.hip_width_m}), 1) << ", ";
+  s << "Pose2Sim's TRC " << fixed(1000 * median_of(c.trc_hip_width_m), 0) << " / "
+    << fixed(1000 * limb_std_m({c.trc_hip_width_m}), 1) << "\n";
+  s << views_left_out_table(c);
   s << "\nFrames with the participant: ";
   for (const Pose2SimRun& r : c.runs)
     s << r.name << " " << r.frames_with_participant << " (other people reported " << r.other_people

@@ -29,12 +29,21 @@ struct Pose2SimMarkerStats {
   std::vector<float> error_used_px;     // triangulator's error on the views used
   std::vector<float> error_all_px;      // ours projected onto every confident detection
   std::vector<float> trc_error_all_px;  // the TRC's marker, the same way (same frames)
+  // Per camera: frames in which its detection has the keypoint with confidence >= 0.3 but the
+  // point was not triangulated from it (the views a rule left out; empty for the fit).
+  std::vector<int> left_out;
+  std::vector<float> left_out_error_px;  // the point projected onto each keypoint left out
+  // The fit only: distance of the fitted joint to the triangulated keypoint it was fitted from
+  // (the same person and frame before the fit): how far the fit itself moves the point.
+  std::vector<float> from_triangulated_m;
 };
 
 struct Pose2SimRun {
   std::string name;
+  bool fitted = false;                           // the skeleton fit's joints, not a triangulation
   std::vector<Pose2SimMarkerStats> markers;      // TRC marker order
   std::vector<std::vector<float>> limb_lengths;  // per limb (pose2sim_limbs()), metres
+  std::vector<float> hip_width_m;                // RHip to LHip per frame
   int frames_with_participant = 0;
   int other_people = 0;
   int outside_people = 0;
@@ -44,7 +53,9 @@ struct Pose2SimComparison {
   std::string trial, calibration, reference;
   std::size_t frames = 0;
   std::vector<std::string> markers;
+  std::vector<std::string> cameras;  // the rig's names, in its order
   std::vector<std::vector<float>> trc_limb_lengths;
+  std::vector<float> trc_hip_width_m;
   std::vector<Pose2SimRun> runs;  // ours, without the prior, Pose2Sim's rule, + skeleton fit
 };
 
@@ -58,7 +69,8 @@ Pose2SimComparison compare_with_pose2sim(const std::filesystem::path& trial,
                                          const std::filesystem::path& calibration,
                                          std::size_t max_frames = 0);
 
-// Markdown: the per-marker table and the limb-length std line.
+// Markdown: the per-marker table, the limb-length std line, the hip width and the views each
+// triangulation left out per marker and camera.
 std::string pose2sim_table(const Pose2SimComparison& c);
 
 float median_of(std::vector<float> v);  // NaN when empty
