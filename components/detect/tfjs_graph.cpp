@@ -30,12 +30,13 @@ constexpr int kDtFloat = 1, kDtInt32 = 3;
 // The ops this loader passes to OpenCV (checked with OpenCV 4.6 on MoveNet MultiPose and
 // single-pose and MB3-CenterNet; NanoDet's NCHW transposes are beyond OpenCV's TF importer); Shape
 // and StridedSlice only occur inside the upsampling chains OpenCV's importer folds into Resize;
-// Mean is a spatial mean (squeeze-and-excite).
+// Mean is a spatial mean (squeeze-and-excite); Pad (zero padding before a strided convolution)
+// and MaxPool (2 x 2, VALID) are BlazePose's, checked by its golden test.
 const std::set<std::string, std::less<>> kPassThroughOps = {
     "Const",   "Placeholder", "Identity", "Conv2D",       "DepthwiseConv2dNative",
     "BiasAdd", "Relu",        "Relu6",    "Add",          "AddV2",
     "Sub",     "Mul",         "Shape",    "StridedSlice", "ResizeBilinear",
-    "Sigmoid", "Mean",        "ConcatV2"};
+    "Sigmoid", "Mean",        "ConcatV2", "Pad",          "MaxPool"};
 const std::set<std::string, std::less<>> kSplitOps = {"_FusedConv2D", "FusedDepthwiseConv2dNative"};
 
 ProtoMessage attr_proto(const TfjsAttr& a) {

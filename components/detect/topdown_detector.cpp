@@ -32,6 +32,8 @@ void check(const TopDownOptions& o) {
   if (o.detector_tiles < 1) throw std::invalid_argument("detector_tiles must be at least 1");
   if (!(o.sure_box_score >= 0.0f && o.sure_box_score <= 1.0f))
     throw std::invalid_argument("sure_box_score must lie in [0, 1] (0: off)");
+  if (!(o.min_pose_presence >= 0.0f && o.min_pose_presence <= 1.0f))
+    throw std::invalid_argument("min_pose_presence must lie in [0, 1]");
   if (o.workers < 1 || o.workers > 16) throw std::invalid_argument("workers must lie in [1, 16]");
   if (o.keypoint_every < 1) throw std::invalid_argument("keypoint_every must be at least 1");
   if (!(o.flow_error > 0.0f && o.flow_error <= 1.0f))
@@ -71,6 +73,24 @@ void join(OrderedWorkers<int>& helpers, int count, std::exception_ptr error) {
 }
 
 }  // namespace
+
+CropVerdict judge_crop(const SinglePose& pose, const TopDownOptions& options) {
+  CropVerdict v;
+  float sum = 0;
+  for (const auto& [y, x, score] : pose.keypoints) {
+    if (score < options.min_keypoint_score) continue;
+    ++v.passing;
+    sum += score;
+  }
+  v.score = v.passing > 0 ? sum / static_cast<float>(v.passing) : 0.0f;
+  if (pose.presence == kNoPresence) {
+    v.posed = v.passing >= options.min_keypoints && v.score >= options.min_person_score;
+  } else {
+    v.score = pose.presence;
+    v.posed = pose.presence >= options.min_pose_presence && v.passing >= 2;
+  }
+  return v;
+}
 
 TopDownDetector::TopDownDetector(const TopDownOptions& options,
                                  const std::filesystem::path& pose_model_json,
@@ -121,7 +141,7 @@ std::vector<Detection> TopDownDetector::find_boxes(const ImageBuffer& frame) {
 
 void TopDownDetector::run_keypoints(int first, int count, int copies) {
   copies = std::clamp(copies, 1, std::max(count, 1));
-  const std::span<SinglePoseKeypoints> out(found_.data() + first, static_cast<std::size_t>(count));
+  const std::span<SinglePose> out(found_.data() + first, static_cast<std::size_t>(count));
   // Copy c takes crops [count c / copies, count (c + 1) / copies).
   const auto share = [&](int c) {
     const int begin = count * c / copies, end = count * (c + 1) / copies;
@@ -166,22 +186,16 @@ void TopDownDetector::people_found(std::vector<Found>& found) const {
   for (std::size_t i = 0; i < found_.size(); ++i) {
     const SquareRegion& r = regions_[i];
     MovenetPerson person;
-    int passing = 0;
-    float sum = 0;
     for (int k = 0; k < kMovenetKeypoints; ++k) {
-      const auto& [y, x, score] = found_[i][k];
-      Keypoint2D& out = person.keypoints[k];
-      if (score >= options_.min_keypoint_score) {
-        out = {r.cx - r.side / 2 + x * r.side, r.cy - r.side / 2 + y * r.side, score};
-        ++passing;
-        sum += score;
-      } else {
-        out = {std::nanf(""), std::nanf(""), 0.0f};
-      }
+      const auto& [y, x, score] = found_[i].keypoints[k];
+      person.keypoints[k] =
+          score >= options_.min_keypoint_score
+              ? Keypoint2D{r.cx - r.side / 2 + x * r.side, r.cy - r.side / 2 + y * r.side, score}
+              : Keypoint2D{std::nanf(""), std::nanf(""), 0.0f};
     }
-    person.score = passing > 0 ? sum / static_cast<float>(passing) : 0.0f;
-    const bool posed =
-        passing >= options_.min_keypoints && person.score >= options_.min_person_score;
+    const CropVerdict verdict = judge_crop(found_[i], options_);
+    person.score = verdict.score;
+    const bool posed = verdict.posed;
     const float box_score = box_scores_[i];
     const bool sure = options_.sure_box_score > 0 && box_score >= options_.sure_box_score;
     if (!posed && !sure) continue;

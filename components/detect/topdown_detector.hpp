@@ -1,6 +1,7 @@
 #pragma once
 // Top-down detection: person boxes from MB3-CenterNet at a low rate, the keypoints of each person
-// from MoveNet single-pose (Lightning or Thunder) on a crop around them, every crop of a frame in
+// from a single-person model (MoveNet Lightning or Thunder, BlazePose lite, full or heavy) on a
+// crop around them, every crop of a frame in
 // one forward pass. Between detector runs each person's next crop comes from their own keypoints
 // (the square around them, moved by their last motion): the detector/tracker split of MediaPipe's
 // pose pipeline and of rtmlib's PoseTracker. A person whose crop no longer shows one is dropped,
@@ -53,6 +54,10 @@ struct TopDownOptions {
   // min_person_score.
   int min_keypoints = 6;
   float min_person_score = 0.35f;
+  // Models with a pose-presence flag (BlazePose): the crop shows a person when the flag reaches
+  // this instead (MediaPipe's threshold on it, 0.5); the keypoints kept are still those scoring
+  // min_keypoint_score.
+  float min_pose_presence = 0.5f;
   // A person the detector is sure of: a box scoring at least this is a person even when its
   // crop's keypoints fail the test above (blurred or crowded people); only the keypoints scoring
   // min_keypoint_score are kept, and the box is the detector's. Such a person is followed until
@@ -75,6 +80,17 @@ struct TopDownOptions {
   int keypoint_every = 1;
   float flow_error = 0.03f;
 };
+
+// The person test of one crop's answer: MoveNet's keypoints (at least min_keypoints scoring
+// min_keypoint_score, their mean reaching min_person_score) or, from a model with a presence flag
+// (BlazePose), the flag reaching min_pose_presence with two keypoints passing to span a box.
+// `score` is the passing keypoints' mean score, or the flag.
+struct CropVerdict {
+  int passing = 0;
+  float score = 0;
+  bool posed = false;
+};
+CropVerdict judge_crop(const SinglePose& pose, const TopDownOptions& options);
 
 // Where the time of detect() went, summed over the frames since the detector was made (seconds,
 // wall clock). CenterNet runs on a helper thread when there are several workers, then overlapping
@@ -151,7 +167,7 @@ class TopDownDetector {
   std::vector<SquareRegion> regions_;
   std::vector<Box2D> crop_boxes_;  // per crop of the frame: the box it was cut around
   std::vector<float> box_scores_;  // per box of the frame: the detector's score of it
-  std::vector<SinglePoseKeypoints> found_;
+  std::vector<SinglePose> found_;
   std::vector<Followed> followed_;
   std::unique_ptr<KeypointFlow> flow_;  // with keypoint_every > 1
   std::vector<FlowPoint> flow_from_, flow_to_;

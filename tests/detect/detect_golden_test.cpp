@@ -1,4 +1,5 @@
-// The C++ ports of MoveNet single-pose (Lightning, Thunder) and MB3-CenterNet (TF.js model run by
+// The C++ ports of MoveNet single-pose (Lightning, Thunder), BlazePose's landmark models (lite,
+// full, heavy) and MB3-CenterNet (TF.js model run by
 // each network runtime, cv::dnn and XNNPACK; post-processing in C++) against the outputs
 // TensorFlow.js computed from the same models and pixels, the graph's own post-processing included
 // (tests/data/detection/tfjs_reference.json, made by tools/reference/make_detect_reference.sh; see
@@ -40,6 +41,11 @@ constexpr double kHeadTolerance = 1e-3;
 constexpr double kKeypointTolerance = 2e-4;
 constexpr double kScoreTolerance = 2e-4;
 constexpr double kBoxTolerance = 0.02;  // pixels of the 512 × 512 input
+// BlazePose: landmarks in pixels of the 256-px crop (z too), visibility and presence logits, and
+// the pose flag.
+constexpr double kLandmarkTolerance = 0.01;
+constexpr double kLogitTolerance = 2e-3;
+constexpr double kFlagTolerance = 2e-4;
 
 class DetectGolden : public ::testing::TestWithParam<Backend> {
  protected:
@@ -158,6 +164,70 @@ TEST_P(DetectGolden, ThunderMatchesTfjsInOneBatch) {
   check_singlepose(SinglePoseModel::thunder, runtime(), cases("movenet-thunder"), fill);
 }
 
+// BlazePose lite, full or heavy on its two windows in one batch: the raw landmarks and flag against
+// TF.js's, then decode_blazepose's COCO-17 keypoints against the reference's own landmarks.
+void check_blazepose(SinglePoseModel model, const RunnerOptions& runtime,
+                     const std::vector<json>& refs,
+                     const std::function<void(const json&, GraphTensor&, int)>& fill) {
+  try {
+    cached_model_json(model_name(model));
+  } catch (const ModelMissing& e) {
+    GTEST_SKIP() << e.what();
+  }
+  ASSERT_EQ(refs.size(), 2u) << "no reference for " << model_name(model)
+                             << " (tools/reference/make_detect_reference.sh)";
+  SinglePoseNetwork network(model, cached_model_json(model_name(model)), runtime);
+  EXPECT_EQ(network.backend(), runtime.backend);
+  const int size = network.input_size();
+  GraphTensor batch;
+  batch.shape = {static_cast<std::int64_t>(refs.size()), size, size, 3};
+  batch.values.assign(batch.size(), 0.0f);
+  for (std::size_t n = 0; n < refs.size(); ++n) fill(refs[n], batch, static_cast<int>(n));
+  const std::vector<GraphTensor> heads = network.run_heads(batch);
+  ASSERT_EQ(heads.size(), 2u);
+  const std::vector<SinglePose> poses = network.run(batch);
+  for (std::size_t n = 0; n < refs.size(); ++n) {
+    SCOPED_TRACE(refs[n].at("id").get<std::string>());
+    const json& want = refs[n].at("output_ld_3d_1x195");
+    ASSERT_EQ(want.size(), std::size_t{kBlazePoseLandmarks} * 5);
+    const float* got = heads[0].values.data() + n * want.size();
+    double worst_xyz = 0, worst_logit = 0;
+    for (std::size_t i = 0; i < want.size(); ++i) {
+      const double d = std::fabs(got[i] - want[i].get<double>());
+      (i % 5 < 3 ? worst_xyz : worst_logit) = std::max(i % 5 < 3 ? worst_xyz : worst_logit, d);
+    }
+    EXPECT_LT(worst_xyz, kLandmarkTolerance);
+    EXPECT_LT(worst_logit, kLogitTolerance);
+    const double flag = refs[n].at("output_poseflag").get<double>();
+    // (The flag is low here, 0.01-0.07: these windows are MoveNet's, a 100-px walker in a 256-px
+    // window, not the person-filling crop BlazePose expects; topdown_detector_test checks the
+    // flag on the crops top-down cuts.)
+    EXPECT_NEAR(poses[n].presence, flag, kFlagTolerance);
+    for (int k = 0; k < kMovenetKeypoints; ++k) {
+      const std::size_t l = static_cast<std::size_t>(kBlazePoseToCoco[k]) * 5;
+      const auto& [y, x, score] = poses[n].keypoints[k];
+      EXPECT_NEAR(x, want[l].get<double>() / size, kLandmarkTolerance / size) << k;
+      EXPECT_NEAR(y, want[l + 1].get<double>() / size, kLandmarkTolerance / size) << k;
+      EXPECT_NEAR(score, 1.0 / (1.0 + std::exp(-want[l + 3].get<double>())), kScoreTolerance) << k;
+    }
+    std::cout << "  " << refs[n].at("id").get<std::string>() << ": landmarks max |diff| "
+              << worst_xyz << " px, logits " << worst_logit << ", flag " << poses[n].presence
+              << " (TF.js " << flag << ")\n";
+  }
+}
+
+TEST_P(DetectGolden, BlazePoseLiteMatchesTfjsInOneBatch) {
+  check_blazepose(SinglePoseModel::blazepose_lite, runtime(), cases("blazepose-lite"), fill);
+}
+
+TEST_P(DetectGolden, BlazePoseFullMatchesTfjsInOneBatch) {
+  check_blazepose(SinglePoseModel::blazepose_full, runtime(), cases("blazepose-full"), fill);
+}
+
+TEST_P(DetectGolden, BlazePoseHeavyMatchesTfjsInOneBatch) {
+  check_blazepose(SinglePoseModel::blazepose_heavy, runtime(), cases("blazepose-heavy"), fill);
+}
+
 // run() goes through the crops in passes of 8, 4, 2, 1 (3 crops: 2 + 1); each crop's keypoints
 // are those of one pass over the whole batch.
 TEST_P(DetectGolden, LightningRunInPassesEqualsOneBatch) {
@@ -171,14 +241,15 @@ TEST_P(DetectGolden, LightningRunInPassesEqualsOneBatch) {
   fill(refs[0], batch, 0);
   fill(refs[1], batch, 1);
   fill(refs[0], batch, 2);
-  const std::vector<SinglePoseKeypoints> passes = network.run(batch);
+  const std::vector<SinglePose> passes = network.run(batch);
   ASSERT_EQ(passes.size(), 3u);
   const std::vector<GraphTensor> heads = network.run_heads(batch);
   for (int n = 0; n < 3; ++n) {
     const SinglePoseKeypoints whole = decode_singlepose(heads[0], heads[1], heads[2], heads[3], n);
     for (int k = 0; k < kMovenetKeypoints; ++k)
       for (int i = 0; i < 3; ++i)
-        EXPECT_NEAR(passes[static_cast<std::size_t>(n)][k][i], whole[k][i], 1e-5) << n << " " << k;
+        EXPECT_NEAR(passes[static_cast<std::size_t>(n)].keypoints[k][i], whole[k][i], 1e-5)
+            << n << " " << k;
   }
 }
 

@@ -159,15 +159,73 @@ TEST(TopDownDetector, PartOfABatchEqualsThatPartOfTheWholeRun) {
   batch.values.resize(batch.size());
   for (std::size_t i = 0; i < batch.values.size(); ++i)
     batch.values[i] = static_cast<float>((i * 7919) % 256);
-  const std::vector<SinglePoseKeypoints> whole = network.run(batch);
-  std::vector<SinglePoseKeypoints> part(3);
+  const std::vector<SinglePose> whole = network.run(batch);
+  std::vector<SinglePose> part(3);
   network.run(batch, 2, 3, part);
   for (int n = 0; n < 3; ++n)
     for (int k = 0; k < kMovenetKeypoints; ++k)
       for (int i = 0; i < 3; ++i)
-        EXPECT_NEAR(part[static_cast<std::size_t>(n)][k][i],
-                    whole[static_cast<std::size_t>(n + 2)][k][i], 1e-5);
+        EXPECT_NEAR(part[static_cast<std::size_t>(n)].keypoints[k][i],
+                    whole[static_cast<std::size_t>(n + 2)].keypoints[k][i], 1e-5);
   EXPECT_THROW(network.run(batch, 4, 2, part), std::invalid_argument);
+}
+
+// The person test of a crop (judge_crop): MoveNet's keypoints, or a presence flag instead.
+TEST(TopDownDetector, APresenceFlagIsThePersonTestOfTheModelsThatHaveOne) {
+  TopDownOptions o;  // 6 keypoints at 0.3, mean 0.35; flag 0.5
+  SinglePose pose;
+  for (int k = 0; k < kMovenetKeypoints; ++k) pose.keypoints[k] = {0.5f, 0.5f, k < 6 ? 0.4f : 0.1f};
+  EXPECT_TRUE(judge_crop(pose, o).posed);
+  EXPECT_EQ(judge_crop(pose, o).passing, 6);
+  EXPECT_NEAR(judge_crop(pose, o).score, 0.4f, 1e-6);
+  pose.keypoints[0][2] = 0.2f;  // five keypoints pass: not a person for MoveNet
+  EXPECT_FALSE(judge_crop(pose, o).posed);
+  pose.presence = 0.7f;  // the flag decides
+  EXPECT_TRUE(judge_crop(pose, o).posed);
+  EXPECT_FLOAT_EQ(judge_crop(pose, o).score, 0.7f);
+  pose.presence = 0.3f;
+  EXPECT_FALSE(judge_crop(pose, o).posed);
+  pose.presence = 0.9f;  // a confident flag, but too few keypoints to span a box
+  for (int k = 1; k < kMovenetKeypoints; ++k) pose.keypoints[k][2] = 0.1f;
+  EXPECT_FALSE(judge_crop(pose, o).posed);
+}
+
+// BlazePose lite in the crops: the pedestrians of vtest frame 300, each with a presence flag of
+// at least MediaPipe's 0.5 as the person score, their keypoints confident ones only.
+TEST(TopDownDetector, BlazePoseFindsThePedestriansOfFrame300) {
+  std::string why;
+  const auto m = models(why);
+  if (!m) GTEST_SKIP() << why;
+  fs::path blazepose;
+  try {
+    blazepose = cached_model_json(model_name(SinglePoseModel::blazepose_lite));
+  } catch (const ModelMissing& e) {
+    GTEST_SKIP() << e.what();
+  }
+  TopDownOptions o;
+  o.pose_model = SinglePoseModel::blazepose_lite;
+  o.detect_every = 3;
+  TopDownDetector detector(o, blazepose, m->centernet);
+  TopDownDetector movenet(TopDownOptions{}, m->lightning, m->centernet);
+  for (int i = 0; i < 3; ++i) {
+    SCOPED_TRACE(i);
+    const auto people = detector.detect(shifted_frame(2 * i));
+    const auto reference = movenet.detect(shifted_frame(2 * i));
+    EXPECT_GE(people.size(), 4u);  // the walkers of frame 300
+    for (const MovenetPerson& p : people) {
+      EXPECT_GE(p.score, o.min_pose_presence);
+      EXPECT_GT(p.box.height, 40.0f);
+      for (const Keypoint2D& k : p.keypoints)
+        EXPECT_TRUE(std::isnan(k.x) || k.confidence >= o.min_keypoint_score);
+    }
+    // The same people as MoveNet's: each of Lightning's finds has a BlazePose find on it.
+    for (const MovenetPerson& r : reference) {
+      const bool same = std::any_of(people.begin(), people.end(), [&](const MovenetPerson& p) {
+        return iou(p.box, r.box) > 0.5f;
+      });
+      EXPECT_TRUE(same) << "Lightning's person at x " << r.box.x << " not found by BlazePose";
+    }
+  }
 }
 
 // Frames 0..5 of the moving picture with the keypoint network every frame, then every third.

@@ -96,13 +96,14 @@ Strategy make_strategy(const std::string& spec, detect::Backend backend, int thr
   }
   if (parts.size() >= 3 && parts[0] == "topdown") {
     detect::TopDownOptions o;
-    if (parts[1] != "lightning" && parts[1] != "thunder")
+    try {
+      o.pose_model = detect::parse_pose_model(parts[1]);
+    } catch (const std::invalid_argument&) {
       throw std::invalid_argument(
-          "topdown:lightning|thunder:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:kEVERY][:"
-          "uSURE], got " +
-          spec);
-    o.pose_model = parts[1] == "thunder" ? detect::SinglePoseModel::thunder
-                                         : detect::SinglePoseModel::lightning;
+          "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:kEVERY][:uSURE] with "
+          "MODEL " +
+          std::string(detect::pose_model_names()) + ", got " + spec);
+    }
     o.detect_every = std::stoi(parts[2]);
     // Then WORKERS and THREADS, and anywhere tN (person detector on N tiles; tNw: and the whole
     // frame), sX (its score threshold), kK (keypoint pass every K frames) and uX (sure_box_score).
@@ -390,21 +391,17 @@ void diagnose(const std::string& input, const eval::DetectionTruth& truth, const
         const detect::SquareRegion region = detect::square_around(above->box, o.crop_padding);
         detect::image_batch(crop, 1, pose.input_size(), pose.input_size());
         detect::fill_region(*f, region, crop, 0);
-        const detect::SinglePoseKeypoints kp = pose.run(crop).front();
+        const detect::SinglePose answer = pose.run(crop).front();
         std::array<Keypoint2D, detect::kMovenetKeypoints> points{};
-        int passing = 0;
-        float sum = 0;
         for (int j = 0; j < detect::kMovenetKeypoints; ++j) {
-          const auto& [y, x, c] = kp[j];
+          const auto& [y, x, c] = answer.keypoints[j];
           if (c < o.min_keypoint_score) continue;
-          ++passing, sum += c;
           points[j] = {region.cx - region.side / 2 + x * region.side,
                        region.cy - region.side / 2 + y * region.side, c};
         }
         // A sure box is a person whatever its keypoints (TopDownOptions::sure_box_score).
         const bool sure = o.sure_box_score > 0 && above->score >= o.sure_box_score;
-        const bool posed =
-            passing >= o.min_keypoints && sum / std::max(1, passing) >= o.min_person_score;
+        const bool posed = detect::judge_crop(answer, o).posed;
         if (!posed && !sure)
           causes["(c1) proposed, crop's keypoints rejected"]++;
         else if (!posed)
@@ -478,9 +475,10 @@ int main(int argc, char** argv) {
               "the first (on the first runtime) is the reference for keypoint distances: "
               "multipose:SIZE, "
               "tiles:CxR:TILE:FRAME, "
-              "topdown:lightning|thunder:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:kEVERY][:"
+              "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:kEVERY][:"
               "uSURE] "
-              "(workers: copies of the keypoint network sharing a frame's crops; tTILES: person "
+              "(MODEL: lightning, thunder, blazepose-lite, blazepose-full, blazepose-heavy; "
+              "workers: copies of the keypoint network sharing a frame's crops; tTILES: person "
               "detector tiles, tTILESw: and the whole frame, sSCORE: its box score floor, uSURE: "
               "boxes scoring SURE are people whatever their keypoints, kEVERY: keypoint pass every "
               "EVERY "

@@ -48,6 +48,19 @@ const std::vector<Network> kNetworks = {
      {kSp + "center_0/conv2d_4/BiasAdd", kSp + "kpt_heatmap_0/conv2d_5/BiasAdd",
       kSp + "kpt_regress_0/conv2d_6/BiasAdd", kSp + "kpt_offset_0/conv2d_7/BiasAdd"}},
     {"centernet", {"tower_0/Sigmoid", "tower_0/mul"}},
+    // BlazePose's landmarks and pose flag, as detect::SinglePoseNetwork cuts it (RGB / 255).
+    {"blazepose-lite",
+     {kSp + "model/convld_3d/BiasAdd", kSp + "model/activation_poseflag/Sigmoid"},
+     false,
+     1.0f / 255},
+    {"blazepose-full",
+     {kSp + "model/convld_3d/BiasAdd", kSp + "model/activation_poseflag/Sigmoid"},
+     false,
+     1.0f / 255},
+    {"blazepose-heavy",
+     {kSp + "model/convld_3d/BiasAdd", kSp + "model/activation_poseflag/Sigmoid"},
+     false,
+     1.0f / 255},
     {"nanodet",
      {"Identity", "Identity_1", "Identity_2", "Identity_3", "Identity_4", "Identity_5"},
      true,
@@ -102,7 +115,7 @@ std::vector<float> input_values(const cv::Mat& rgb, int width, int height, const
 // their fixed size.
 std::vector<std::pair<int, int>> sizes(const std::string& model, const std::string& multipose) {
   if (model == "movenet-lightning") return {{192, 192}};
-  if (model == "movenet-thunder") return {{256, 256}};
+  if (model == "movenet-thunder" || model.starts_with("blazepose")) return {{256, 256}};
   if (model == "centernet") return {{512, 512}};
   if (model == "nanodet") return {{416, 416}};
   std::vector<std::pair<int, int>> out;
@@ -123,7 +136,8 @@ int main(int argc, char** argv) {
   args.option("image", "PNG", "frame the inputs are resized from",
               "../shared/docs/models/movenet-multipose/vtest-f300.png")
       .option("models", "LIST", "models (folders of the model cache)",
-              "movenet-multipose,movenet-lightning,movenet-thunder,centernet,nanodet")
+              "movenet-multipose,movenet-lightning,movenet-thunder,centernet,nanodet,"
+              "blazepose-lite,blazepose-full,blazepose-heavy")
       .option("multipose-sizes", "LIST", "MoveNet MultiPose input long sides (4:3)", "256,384,512")
       .option("backends", "LIST", "runtimes: opencv, xnnpack", "opencv,xnnpack")
       .option("threads", "LIST", "thread counts", "1,2")

@@ -32,6 +32,7 @@
 #include "core/keypoint_layout.hpp"
 #include "core/messages.hpp"
 #include "detect/model_files.hpp"
+#include "detect/singlepose.hpp"
 #include "detector_presets.hpp"
 #include "eval_report.hpp"
 #include "graph/graph_spec.hpp"
@@ -336,8 +337,12 @@ void check_detector_model(const graph::GraphSpec& spec) {
       if (!given(node, "box_model_file")) detect::cached_model_json("centernet");
       if (!given(node, "pose_model_file")) {
         const auto it = node.params.find("pose_model");
-        const bool thunder = it != node.params.end() && it->second.text == "thunder";
-        detect::cached_model_json(thunder ? "movenet-thunder" : "movenet-lightning");
+        // An unknown name is left to the node, whose error lists the accepted ones.
+        try {
+          detect::cached_model_json(detect::model_name(
+              detect::parse_pose_model(it != node.params.end() ? it->second.text : "lightning")));
+        } catch (const std::invalid_argument&) {
+        }
       }
     }
   }

@@ -1,13 +1,14 @@
 #!/usr/bin/env node
-// Makes the golden reference for the C++ ports of MoveNet single-pose (Lightning, Thunder) and
-// MB3-CenterNet: runs each unchanged TF.js graph model with TensorFlow.js's pure-JS CPU backend on
+// Makes the golden reference for the C++ ports of MoveNet single-pose (Lightning, Thunder),
+// BlazePose's landmark models (lite, full, heavy) and MB3-CenterNet: runs each unchanged TF.js graph model with TensorFlow.js's pure-JS CPU backend on
 // square windows cut (whole pixels, no resizing, so that the C++ test cuts the same bytes) from
 // the MoveNet reference frame, and writes the models' own outputs and statistics of their heads.
 //
 // Run it through make_detect_reference.sh, which installs @tensorflow/tfjs and pngjs into a cache
 // outside the repository. Directly:
 //   node make_detect_reference.js MODEL_ROOT FRAME.png OUT.json [--check OLD.json]
-// MODEL_ROOT holds movenet-lightning/, movenet-thunder/ and centernet/ (tools/setup.sh
+// MODEL_ROOT holds movenet-lightning/, movenet-thunder/, blazepose-{lite,full,heavy}/ and
+// centernet/ (tools/setup.sh
 // --models-only), FRAME.png is vtest-f300.png (../shared/docs/models/movenet-multipose/).
 'use strict';
 
@@ -25,6 +26,12 @@ const CASES = [
   { id: 'lightning_vtest_f300_x499_y100', model: 'movenet-lightning', x: 499, y: 100, size: 192 },
   { id: 'thunder_vtest_f300_x74_y68', model: 'movenet-thunder', x: 74, y: 68, size: 256 },
   { id: 'thunder_vtest_f300_x467_y68', model: 'movenet-thunder', x: 467, y: 68, size: 256 },
+  { id: 'blazepose-lite_vtest_f300_x74_y68', model: 'blazepose-lite', x: 74, y: 68, size: 256 },
+  { id: 'blazepose-lite_vtest_f300_x467_y68', model: 'blazepose-lite', x: 467, y: 68, size: 256 },
+  { id: 'blazepose-full_vtest_f300_x74_y68', model: 'blazepose-full', x: 74, y: 68, size: 256 },
+  { id: 'blazepose-full_vtest_f300_x467_y68', model: 'blazepose-full', x: 467, y: 68, size: 256 },
+  { id: 'blazepose-heavy_vtest_f300_x74_y68', model: 'blazepose-heavy', x: 74, y: 68, size: 256 },
+  { id: 'blazepose-heavy_vtest_f300_x467_y68', model: 'blazepose-heavy', x: 467, y: 68, size: 256 },
   { id: 'centernet_vtest_f300_x128_y32', model: 'centernet', x: 128, y: 32, size: 512 },
   { id: 'centernet_vtest_f300_x0_y0', model: 'centernet', x: 0, y: 0, size: 512 },
 ];
@@ -58,6 +65,15 @@ function runSingle(m, rgb, c) {
     heads: SINGLE_HEADS.map((name, i) => summary(name, outs[1 + i], cells.slice(0, 3))) };
 }
 
+// BlazePose takes RGB / 255 (as MediaPipe and @vladmandic/human feed it); its outputs ld_3d
+// (Identity_2: 39 landmarks x (x, y, z, visibility logit, presence logit), pixels of the input)
+// and output_poseflag (Identity_3: the pose-presence flag, after its sigmoid).
+function runBlazePose(m, rgb, c) {
+  const x = tf.tensor4d(Float32Array.from(rgb, (v) => v / 255), [1, c.size, c.size, 3], 'float32');
+  const outs = m.model.execute(x, ['Identity_2', 'Identity_3']);
+  return { output_ld_3d_1x195: Array.from(outs[0].dataSync()), output_poseflag: outs[1].dataSync()[0] };
+}
+
 function runCenternet(m, rgb, c) {
   const x = tf.tensor4d(Float32Array.from(rgb), [1, c.size, c.size, 3], 'float32');
   const outs = m.model.execute(x, ['tower_0/detections', ...CENTERNET_HEADS]);
@@ -78,9 +94,12 @@ async function main() {
   const cases = CASES.map((c) => {
     const rgb = cutWindow(frame, c);
     const m = models[c.model];
-    const result = c.model === 'centernet' ? runCenternet(m, rgb, c) : runSingle(m, rgb, c);
+    const result = c.model === 'centernet' ? runCenternet(m, rgb, c)
+      : c.model.startsWith('blazepose') ? runBlazePose(m, rgb, c) : runSingle(m, rgb, c);
     return { id: c.id, model: c.model, window_x_y_size: [c.x, c.y, c.size], input_rgb_bytes_sha256: sha256(rgb),
-      input: c.model === 'centernet' ? 'float32 [1,512,512,3] RGB 0..255' : `int32 [1,${c.size},${c.size},3] RGB 0..255`,
+      input: c.model === 'centernet' ? 'float32 [1,512,512,3] RGB 0..255'
+        : c.model.startsWith('blazepose') ? `float32 [1,${c.size},${c.size},3] RGB / 255`
+          : `int32 [1,${c.size},${c.size},3] RGB 0..255`,
       ...result };
   });
   const reference = {

@@ -1,7 +1,8 @@
 // detect.topdown: person boxes from MB3-CenterNet every few frames, keypoints per person from
-// MoveNet single-pose on crops that follow each person in between (components/detect
-// TopDownDetector). No cap on the number of people. Models come from the cache tools/setup.sh
-// fills; a missing or wrong one stops the graph naming it and that command.
+// a single-person model (MoveNet Lightning or Thunder, BlazePose) on crops that follow each person
+// in between (components/detect TopDownDetector). No cap on the number of people. Models come from
+// the cache tools/setup.sh fills; a missing or wrong one stops the graph naming it and that
+// command.
 
 #include <iostream>
 #include <optional>
@@ -18,12 +19,14 @@ class TopDownNode : public Node {
  public:
   static void contract(Contract& c) {
     c.doc(
-        "Finds every person: CenterNet boxes at a low rate, MoveNet single-pose keypoints per "
-        "person on crops that follow them (cv::dnn or XNNPACK)");
+        "Finds every person: CenterNet boxes at a low rate, single-person keypoints (MoveNet or "
+        "BlazePose) per person on crops that follow them (cv::dnn or XNNPACK)");
     c.input<VideoFrame>("in", "video frames in order, any pixel format");
     c.output<People2D>("out", "COCO-17 people in frame pixels, best first, id -1 (untracked)");
     c.param<std::string>("pose_model", "lightning",
-                         "keypoints per crop: lightning (192 px, fast) or thunder (256 px)");
+                         "keypoints per crop: lightning (MoveNet, 192 px, fast), thunder (MoveNet, "
+                         "256 px), blazepose-lite, blazepose-full or blazepose-heavy (256 px, "
+                         "their pose-presence flag is the person test)");
     c.param<int>("detect_every", 10,
                  "frames between person-detector runs (1: every frame); it also runs after a "
                  "frame that lost somebody",
@@ -40,6 +43,10 @@ class TopDownNode : public Node {
     c.param<double>("sure_box_score", 0.0,
                     "a person box the detector scores this high is a person even when the crop's "
                     "keypoints fail the person test (only the confident keypoints kept); 0: off",
+                    {0.0, 1.0});
+    c.param<double>("min_pose_presence", 0.5,
+                    "BlazePose: a crop whose pose-presence flag is below shows nobody "
+                    "(MediaPipe's threshold)",
                     {0.0, 1.0});
     c.param<double>("min_person_score", 0.35,
                     "a crop whose passing keypoints score less on average shows nobody",
@@ -68,10 +75,8 @@ class TopDownNode : public Node {
   void open(Context& ctx) override {
     detect::TopDownOptions o;
     const std::string model = ctx.param<std::string>("pose_model");
-    if (model != "lightning" && model != "thunder")
-      throw std::invalid_argument("pose_model must be lightning or thunder, got '" + model + "'");
-    o.pose_model =
-        model == "thunder" ? detect::SinglePoseModel::thunder : detect::SinglePoseModel::lightning;
+    o.pose_model = detect::parse_pose_model(model);
+    o.min_pose_presence = ctx.param<float>("min_pose_presence");
     o.detect_every = ctx.param<int>("detect_every");
     o.min_box_score = ctx.param<float>("min_box_score");
     o.detector_tiles = ctx.param<int>("detector_tiles");
