@@ -26,17 +26,25 @@ VideoFrame frame(const std::string& camera, std::int64_t capture_ms, std::int64_
 }
 
 TEST(SetLimiter, NumbersEverySetAndPassesOnlyWhileIdle) {
-  SetLimiter limiter;
-  EXPECT_EQ(limiter.admit(true, true), 0);
-  EXPECT_EQ(limiter.admit(true, false), std::nullopt);
-  EXPECT_EQ(limiter.admit(false, false), std::nullopt);
-  EXPECT_EQ(limiter.admit(false, true), 3);  // dropped sets keep their numbers
+  constexpr std::int64_t kMs = 1'000'000;
+  SetLimiter limiter(2, 200 * kMs);
+  const std::vector<bool> both = {true, true}, first = {true, false};
+  EXPECT_EQ(limiter.admit(both, 0, true), 0);
+  EXPECT_EQ(limiter.admit(both, 33 * kMs, false), std::nullopt);  // busy
+  // Camera 1 seen 33 ms ago: its frame fell outside this set (jitter), which is dropped.
+  EXPECT_EQ(limiter.admit(first, 66 * kMs, true), std::nullopt);
+  // Nothing from camera 1 for more than 200 ms: it is away, the other goes on alone.
+  EXPECT_EQ(limiter.admit(first, 300 * kMs, true), 3);  // dropped sets keep their numbers
   EXPECT_EQ(limiter.counts().sets, 4u);
   EXPECT_EQ(limiter.counts().passed, 2u);
   EXPECT_EQ(limiter.counts().passed_complete, 1u);
-  EXPECT_EQ(limiter.counts().dropped_busy, 2u);
+  EXPECT_EQ(limiter.counts().dropped_busy, 1u);
+  EXPECT_EQ(limiter.counts().dropped_partial, 1u);
   EXPECT_EQ(limiter.describe(),
-            "passed 2 of 4 sets (1 complete), 2 dropped while the stage was busy");
+            "passed 2 of 4 sets (1 complete), 1 dropped while the stage was busy, 1 partial");
+  // A camera never seen is away: the others start without it.
+  SetLimiter starting(2, 200 * kMs);
+  EXPECT_EQ(starting.admit(first, 0, true), 0);
 }
 
 TEST(SetLimiter, NodeDropsWholeSetsWhileAnyStageIsBusy) {
@@ -65,7 +73,8 @@ TEST(SetLimiter, NodeDropsWholeSetsWhileAnyStageIsBusy) {
   EXPECT_EQ(a[1]->header.capture_ns, 166'000'000);
   EXPECT_EQ(b[1]->camera, "b");
   EXPECT_EQ(limit.stats().drops, 2u);  // the two frames of set 1
-  EXPECT_EQ(limit.status(), "passed 2 of 3 sets (2 complete), 1 dropped while the stage was busy");
+  EXPECT_EQ(limit.status(),
+            "passed 2 of 3 sets (2 complete), 1 dropped while the stage was busy, 0 partial");
 }
 
 TEST(SetLimiter, RepeatedOutputStreamsFollowTheInputsEdges) {

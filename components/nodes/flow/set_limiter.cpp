@@ -1,11 +1,15 @@
 // flow.set_limiter: several cameras' frames joined by capture time, passed on as whole sets to a
 // stage slower than the cameras (one detector per camera), only while every detector is idle;
-// the sets that arrive while any is busy are dropped whole (graph/set_limiter.hpp says why).
+// the sets that arrive while any is busy are dropped whole, and partial sets unless the cameras
+// they lack are away (no frame for sync_wait_ms): graph/set_limiter.hpp says why.
 // Stream i of `frames` out goes with camera edge i; each frame's header.frame becomes its set's
 // number, so the stage's outputs join by frame number (`sync_by: frame`) after it.
 
-#include "graph/set_limiter.hpp"
+#include <optional>
+#include <vector>
+
 #include "graph/registry.hpp"
+#include "graph/set_limiter.hpp"
 
 namespace mocap::nodes {
 using namespace mocap::graph;
@@ -21,14 +25,21 @@ class SetLimiterNode : public Node {
     c.join({{"frames"}, SyncKey::capture_time, 64, 10.0, 200.0});
   }
 
+  void open(Context& ctx) override {
+    const auto stall_ns = static_cast<std::int64_t>(ctx.param<double>("sync_wait_ms") * 1e6);
+    limiter_.emplace(ctx.input_count("frames"), stall_ns);
+    present_.resize(ctx.input_count("frames"));
+  }
+
   void process(Context& ctx) override {
-    const std::size_t cameras = ctx.input_count("frames");
-    bool complete = true, idle = true;
+    const std::size_t cameras = present_.size();
+    bool idle = true;
     for (std::size_t i = 0; i < cameras; ++i) {
-      complete = complete && ctx.has("frames", i);
+      present_[i] = ctx.has("frames", i);
       idle = idle && ctx.output_idle("frames", i);
     }
-    const std::optional<std::int64_t> number = limiter_.admit(complete, idle);
+    const std::optional<std::int64_t> number =
+        limiter_->admit(present_, ctx.header().capture_ns, idle);
     for (std::size_t i = 0; i < cameras; ++i) {
       if (!ctx.has("frames", i)) continue;
       if (!number) {
@@ -39,13 +50,16 @@ class SetLimiterNode : public Node {
       frame.header.frame = *number;
       ctx.send("frames", i, std::move(frame));
     }
-    if (limiter_.counts().sets % 30 == 1) ctx.report_status(limiter_.describe());
+    if (limiter_->counts().sets % 30 == 1) ctx.report_status(limiter_->describe());
   }
 
-  void close(Context& ctx) override { ctx.report_status(limiter_.describe()); }
+  void close(Context& ctx) override {
+    if (limiter_) ctx.report_status(limiter_->describe());
+  }
 
  private:
-  SetLimiter limiter_;
+  std::optional<SetLimiter> limiter_;
+  std::vector<bool> present_;
 };
 
 MOCAP_REGISTER_NODE("flow.set_limiter", SetLimiterNode)
