@@ -12,6 +12,7 @@
 #include "core/input_error.hpp"
 #include "eval/procrustes.hpp"
 #include "fit/track_fit.hpp"
+#include "multiview/rig_reconstruction.hpp"
 #include "posedb/builder.hpp"
 
 namespace mocap::eval {
@@ -50,7 +51,7 @@ std::vector<ScenePerson> place_people(const std::vector<TruthSequence>& clips, i
 
 // `views` cameras of a ring of max(views, 4): two or three are 90 degrees apart, as such rigs are
 // set up (opposite cameras see depth along their axis poorly).
-std::vector<SceneCamera> rig(int views) {
+std::vector<camera::Camera> rig(int views) {
   auto cameras = ring_rig(std::max(views, 4), 6.0, 1.6, 0.9, {0.0, 1.0, 0.0}, Image{});
   cameras.resize(static_cast<std::size_t>(views));
   return cameras;
@@ -169,7 +170,7 @@ std::vector<MultiviewResult> run_multiview_case(const std::vector<TruthSequence>
   const auto people = place_people(clips, scene.people, options.frames, options.seed);
   const auto cameras = rig(scene.views);
   std::vector<multiview::ViewGeometry> geometry;
-  for (const SceneCamera& c : cameras) geometry.push_back(c.geometry());
+  for (const camera::Camera& c : cameras) geometry.push_back(multiview::from_camera(c));
   SceneRenderer renderer(cameras, options.seed);
   SceneDegradation d;
   d.noise = scene.noise;
@@ -187,7 +188,7 @@ std::vector<MultiviewResult> run_multiview_case(const std::vector<TruthSequence>
   // (iv) fits (iii)'s reconstruction: it is kept, with the CPU time it took. The fit's weights
   // are its defaults (chosen on train scenes, docs/fitting.md), the floor the scene's (y = 0).
   fit::MultiViewFitOptions fit_options;
-  fit_options.cameras = scene_cameras(cameras);
+  fit_options.cameras = cameras;
   fit_options.fit = fit::multiview_fit_defaults();
   fit_options.fit.ground = GroundPlane{{0.0, 1.0, 0.0}, 0.0};
   std::vector<multiview::FrameResult> tracked;

@@ -73,46 +73,27 @@ glm::vec2 centre_of(const SceneDetection& d) {
 
 }  // namespace
 
-glm::dvec3 SceneCamera::centre() const { return -(glm::transpose(R) * t); }
-
-multiview::ViewGeometry SceneCamera::geometry() const {
-  return multiview::ViewGeometry::from_krt(K, R, t, width, height);
-}
-
-std::vector<camera::Camera> scene_cameras(std::span<const SceneCamera> cameras) {
-  std::vector<camera::Camera> out;
-  for (std::size_t i = 0; i < cameras.size(); ++i) {
-    const SceneCamera& s = cameras[i];
-    camera::Camera& c = out.emplace_back();
-    c.name = (i + 1 < 10 ? "cam_0" : "cam_") + std::to_string(i + 1);
-    c.width = s.width, c.height = s.height;
-    c.fx = s.K[0][0], c.fy = s.K[1][1], c.cx = s.K[2][0], c.cy = s.K[2][1];
-    c.rotation = s.R;
-    c.translation = s.t;
-  }
-  return out;
-}
-
-std::vector<SceneCamera> ring_rig(int count, double radius_m, double height_m, double height_step_m,
-                                  const glm::dvec3& target, const Image& image) {
+std::vector<camera::Camera> ring_rig(int count, double radius_m, double height_m,
+                                     double height_step_m, const glm::dvec3& target,
+                                     const Image& image) {
   if (count <= 0) throw std::invalid_argument("ring_rig: needs at least one camera");
   const double focal = 0.5 * image.width /
                        std::tan(glm::radians(static_cast<double>(image.horizontal_fov_deg)) / 2.0);
-  std::vector<SceneCamera> out;
+  std::vector<camera::Camera> out;
   for (int i = 0; i < count; ++i) {
     const double a = 2.0 * std::numbers::pi * i / count;
     const glm::dvec3 centre(target.x + radius_m * std::cos(a),
                             height_m + (i % 2 == 1 ? height_step_m : 0.0),
                             target.z + radius_m * std::sin(a));
-    SceneCamera c;
+    camera::Camera c;
+    c.name = (i + 1 < 10 ? "cam_0" : "cam_") + std::to_string(i + 1);
     c.width = image.width;
     c.height = image.height;
-    c.K = glm::dmat3(1.0);
-    c.K[0][0] = c.K[1][1] = focal;
-    c.K[2][0] = 0.5 * image.width;
-    c.K[2][1] = 0.5 * image.height;
-    c.R = look_at(centre, target);
-    c.t = -(c.R * centre);
+    c.fx = c.fy = focal;
+    c.cx = 0.5 * image.width;
+    c.cy = 0.5 * image.height;
+    c.rotation = look_at(centre, target);
+    c.translation = -(c.rotation * centre);
     out.push_back(c);
   }
   return out;
@@ -190,28 +171,30 @@ bool spread_people(std::vector<ScenePerson>& people, int frames, float room_half
   return all;
 }
 
-SceneRenderer::SceneRenderer(std::vector<SceneCamera> cameras, std::uint64_t seed)
+SceneRenderer::SceneRenderer(std::vector<camera::Camera> cameras, std::uint64_t seed)
     : cameras_(std::move(cameras)), rng_(seed), bystanders_(cameras_.size()) {
   for (SceneDetection& b : bystanders_) b.person = -2;  // not made yet
 }
 
-SceneRenderer::Projected SceneRenderer::project(const SceneCamera& camera, const Body& body) const {
+SceneRenderer::Projected SceneRenderer::project(const camera::Camera& camera,
+                                                const Body& body) const {
   Projected p;
   for (int j = 0; j < kBodyJoints; ++j) {
-    const glm::dvec3 c = camera.R * glm::dvec3(body[j]) + camera.t;
+    const glm::dvec3 c = camera.to_camera(glm::dvec3(body[j]));
     p.depth[j] = static_cast<float>(c.z);
     if (!(c.z > 0.1)) continue;
-    const glm::dvec3 h = camera.K * (c / c.z);
+    const glm::dvec3 n = c / c.z;
+    const glm::dvec2 h(camera.fx * n.x + camera.cx, camera.fy * n.y + camera.cy);
     p.pixel[j] = glm::vec2(h);
     p.in_view[j] = h.x >= 0.0 && h.x < camera.width && h.y >= 0.0 && h.y < camera.height;
   }
   return p;
 }
 
-bool SceneRenderer::hidden(const SceneCamera& camera, const Projected& who, int joint,
+bool SceneRenderer::hidden(const camera::Camera& camera, const Projected& who, int joint,
                            const std::vector<Projected>& others, std::size_t self) const {
   const glm::vec2 u = who.pixel[joint];
-  const float focal = static_cast<float>(camera.K[0][0]);
+  const float focal = static_cast<float>(camera.fx);
   for (std::size_t o = 0; o < others.size(); ++o) {
     if (o == self) continue;
     const Projected& q = others[o];
@@ -257,7 +240,8 @@ void SceneRenderer::degrade(SceneDetection& d, const SceneDegradation& g) {
   }
 }
 
-SceneDetection SceneRenderer::false_detection(const SceneFrame& frame, const SceneCamera& camera) {
+SceneDetection SceneRenderer::false_detection(const SceneFrame& frame,
+                                              const camera::Camera& camera) {
   std::vector<const SceneDetection*> real;
   for (const auto& view : frame.views) {
     for (const SceneDetection& d : view) {
@@ -291,7 +275,7 @@ SceneFrame SceneRenderer::render(const std::vector<ScenePerson>& people, int fra
   std::vector<Projected> projected;
   std::vector<std::size_t> who;
   for (std::size_t c = 0; c < cameras_.size(); ++c) {
-    const SceneCamera& camera = cameras_[c];
+    const camera::Camera& camera = cameras_[c];
     projected.clear();
     who.clear();
     for (std::size_t p = 0; p < people.size(); ++p) {

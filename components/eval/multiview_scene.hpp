@@ -28,25 +28,13 @@
 
 namespace mocap::eval {
 
-struct SceneCamera {
-  glm::dmat3 K{1.0};  // GLM (column-major)
-  glm::dmat3 R{1.0};  // world -> camera
-  glm::dvec3 t{0.0};
-  int width = 1920, height = 1080;
-
-  glm::dvec3 centre() const;
-  multiview::ViewGeometry geometry() const;
-};
-
-// The scene's cameras as the one camera model (no distortion), named cam_01, cam_02, ...: what
-// the multi-view fit takes.
-std::vector<camera::Camera> scene_cameras(std::span<const SceneCamera> cameras);
-
 // `count` cameras evenly spaced on a circle of `radius_m` around the vertical axis through
 // `target`, at heights alternating between height_m and height_m + height_step_m, each looking at
-// `target`, with `image`'s size and horizontal field of view.
-std::vector<SceneCamera> ring_rig(int count, double radius_m, double height_m, double height_step_m,
-                                  const glm::dvec3& target, const Image& image);
+// `target`, with `image`'s size and horizontal field of view: pinholes (no distortion) named
+// cam_01, cam_02, ... (multiview::from_camera gives a camera's ViewGeometry).
+std::vector<camera::Camera> ring_rig(int count, double radius_m, double height_m,
+                                     double height_step_m, const glm::dvec3& target,
+                                     const Image& image);
 
 // One person of the scene: a mocap motion moved to a place in the room.
 struct ScenePerson {
@@ -98,9 +86,9 @@ struct SceneFrame {
 
 class SceneRenderer {
  public:
-  SceneRenderer(std::vector<SceneCamera> cameras, std::uint64_t seed);
+  SceneRenderer(std::vector<camera::Camera> cameras, std::uint64_t seed);
 
-  const std::vector<SceneCamera>& cameras() const { return cameras_; }
+  const std::vector<camera::Camera>& cameras() const { return cameras_; }
   SceneFrame render(const std::vector<ScenePerson>& people, int frame,
                     const SceneDegradation& degradation);
   // The frame's detections as the library's input.
@@ -112,13 +100,13 @@ class SceneRenderer {
     std::array<float, kBodyJoints> depth{};
     std::array<bool, kBodyJoints> in_view{};
   };
-  Projected project(const SceneCamera& camera, const Body& body) const;
-  bool hidden(const SceneCamera& camera, const Projected& who, int joint,
+  Projected project(const camera::Camera& camera, const Body& body) const;
+  bool hidden(const camera::Camera& camera, const Projected& who, int joint,
               const std::vector<Projected>& others, std::size_t self) const;
   void degrade(SceneDetection& d, const SceneDegradation& degradation);
-  SceneDetection false_detection(const SceneFrame& frame, const SceneCamera& camera);
+  SceneDetection false_detection(const SceneFrame& frame, const camera::Camera& camera);
 
-  std::vector<SceneCamera> cameras_;
+  std::vector<camera::Camera> cameras_;
   std::mt19937_64 rng_;
   std::normal_distribution<float> gauss_{0.0f, 1.0f};
   std::uniform_real_distribution<float> uniform_{0.0f, 1.0f};

@@ -4,14 +4,14 @@
 
 namespace mocap::eval {
 
-ShiftedViews shifted_views(const ScenePerson& person, const std::vector<SceneCamera>& cameras,
+ShiftedViews shifted_views(const ScenePerson& person, const std::vector<camera::Camera>& cameras,
                            const std::vector<int>& starts, const std::vector<int>& phases,
                            int steps, int frames, const SceneDegradation& degradation,
                            std::uint64_t seed) {
   if (starts.size() != phases.size() || starts.size() > cameras.size())
     throw std::invalid_argument("shifted_views: one start and phase per view, a camera each");
   ShiftedViews out;
-  out.cameras = scene_cameras(cameras);
+  out.cameras = cameras;
   SceneRenderer renderer(cameras, seed);
   out.views.resize(starts.size());
   for (std::size_t v = 0; v < starts.size(); ++v) {

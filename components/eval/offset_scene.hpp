@@ -20,7 +20,7 @@ struct ShiftedViews {
 // `cameras` (one view per entry of `starts`, which must not outnumber them): view v's frame i is
 // scene step (i + starts[v]) * steps + phases[v], so view v starts (starts[v] - starts[0]) +
 // (phases[v] - phases[0]) / steps frames after view 0. Degraded as `degradation` says.
-ShiftedViews shifted_views(const ScenePerson& person, const std::vector<SceneCamera>& cameras,
+ShiftedViews shifted_views(const ScenePerson& person, const std::vector<camera::Camera>& cameras,
                            const std::vector<int>& starts, const std::vector<int>& phases,
                            int steps, int frames, const SceneDegradation& degradation,
                            std::uint64_t seed);

@@ -19,17 +19,6 @@ namespace {
 
 constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
 
-std::vector<fs::path> json_folders(const fs::path& pose) {
-  std::vector<fs::path> out;
-  std::error_code ec;
-  for (const auto& entry : fs::directory_iterator(pose, ec))
-    if (entry.is_directory() && entry.path().filename().string().ends_with("_json"))
-      out.push_back(entry.path());
-  if (ec) throw InputError(pose.string(), "cannot be listed: " + ec.message());
-  std::sort(out.begin(), out.end());
-  return out;
-}
-
 fs::path reference_trc(const fs::path& pose3d) {
   std::error_code ec;
   for (const auto& entry : fs::directory_iterator(pose3d, ec))
@@ -56,17 +45,11 @@ double distance_to(const recon::BodyXyc& body, const std::array<glm::dvec2, kBod
   return median(d);
 }
 
-// BODY_25B keypoint index of each TRC marker name (Pose2Sim: Neck = UpperNeck, Head = HeadTop).
+// BODY_25B keypoint index of each TRC marker that is one.
 std::vector<std::pair<std::size_t, int>> marker_keypoints(const io::TrcFile& trc) {
-  const KeypointLayout& layout = mocap::layout(LayoutId::body25b);
   std::vector<std::pair<std::size_t, int>> out;
-  for (std::size_t m = 0; m < trc.markers.size(); ++m) {
-    std::string_view name = trc.markers[m];
-    if (name == "Neck") name = "UpperNeck";
-    if (name == "Head") name = "HeadTop";
-    for (std::size_t k = 0; k < layout.keypoints.size(); ++k)
-      if (layout.keypoints[k] == name) out.emplace_back(m, static_cast<int>(k));
-  }
+  for (std::size_t m = 0; m < trc.markers.size(); ++m)
+    if (const int k = pose2sim_marker_keypoint(trc.markers[m]); k >= 0) out.emplace_back(m, k);
   return out;
 }
 
@@ -78,6 +61,32 @@ double median(std::vector<double> d) {
 
 }  // namespace
 
+std::vector<fs::path> pose2sim_json_folders(const fs::path& trial, std::size_t cameras,
+                                            const fs::path& calibration) {
+  const fs::path pose = trial / "pose";
+  std::vector<fs::path> out;
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(pose, ec))
+    if (entry.is_directory() && entry.path().filename().string().ends_with("_json"))
+      out.push_back(entry.path());
+  if (ec) throw InputError(pose.string(), "cannot be listed: " + ec.message());
+  std::sort(out.begin(), out.end());
+  if (out.size() != cameras)
+    throw InputError(pose.string(), std::to_string(out.size()) + " camXX_json folders for " +
+                                        std::to_string(cameras) + " cameras in " +
+                                        calibration.string());
+  return out;
+}
+
+int pose2sim_marker_keypoint(std::string_view marker) {
+  if (marker == "Neck") marker = "UpperNeck";
+  if (marker == "Head") marker = "HeadTop";
+  const KeypointLayout& layout = mocap::layout(LayoutId::body25b);
+  for (std::size_t k = 0; k < layout.keypoints.size(); ++k)
+    if (layout.keypoints[k] == marker) return static_cast<int>(k);
+  return -1;
+}
+
 glm::dvec3 trc_to_world(const glm::vec3& trc) { return {trc.z, trc.x, trc.y}; }
 
 Pose2SimTrial load_pose2sim_trial(const fs::path& trial, const fs::path& calibration,
@@ -85,11 +94,7 @@ Pose2SimTrial load_pose2sim_trial(const fs::path& trial, const fs::path& calibra
   Pose2SimTrial out;
   out.folder = trial.string();
   const auto cameras = camera::read_rig(calibration).cameras;
-  const auto folders = json_folders(trial / "pose");
-  if (folders.size() != cameras.size())
-    throw InputError((trial / "pose").string(),
-                     std::to_string(folders.size()) + " camXX_json folders for " +
-                         std::to_string(cameras.size()) + " cameras in " + calibration.string());
+  const auto folders = pose2sim_json_folders(trial, cameras.size(), calibration);
   const fs::path trc_path = reference_trc(trial / "pose-3d");
   out.reference_file = trc_path.string();
   const io::TrcFile trc = io::read_trc(trc_path);

@@ -15,6 +15,7 @@
 
 #include <filesystem>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "camera/camera.hpp"
@@ -49,6 +50,16 @@ struct Pose2SimTrial {
 Pose2SimTrial load_pose2sim_trial(const std::filesystem::path& trial,
                                   const std::filesystem::path& calibration,
                                   std::size_t max_frames = 0);
+
+// The trial's pose/camXX_json folders in name order, one per camera of `calibration` (which has
+// `cameras`); throws InputError naming the folder when it cannot be listed or the counts differ.
+std::vector<std::filesystem::path> pose2sim_json_folders(const std::filesystem::path& trial,
+                                                         std::size_t cameras,
+                                                         const std::filesystem::path& calibration);
+
+// The BODY_25B keypoint a TRC marker is: the one of its name, but Neck = UpperNeck and Head =
+// HeadTop (Pose2Sim's names); -1: none.
+int pose2sim_marker_keypoint(std::string_view marker);
 
 // The TRC point (Y up, OpenSim) in the calibration's Z-up world: (Z, X, Y).
 glm::dvec3 trc_to_world(const glm::vec3& trc);

@@ -1,6 +1,6 @@
 #pragma once
-// The multi-view fit on a reconstructed virtual scene (eval/multiview_scene.hpp): the scene's
-// cameras as the one camera model (eval::scene_cameras) and every track of a reconstruction
+// The multi-view fit on a reconstructed virtual scene (eval/multiview_scene.hpp; its cameras are
+// the one camera model, camera::Camera) and every track of a reconstruction
 // fitted (fit_tracks, track_fit.hpp), its fitted bodies written over the triangulated ones so
 // that eval::SceneScorer scores them as it scores the triangulation.
 
@@ -8,8 +8,4 @@
 #include "fit/multiview_fit.hpp"
 #include "fit/track_fit.hpp"
 
-namespace mocap::fit {
-
-using eval::scene_cameras;
-
-}  // namespace mocap::fit
+namespace mocap::fit {}  // namespace mocap::fit

@@ -23,7 +23,8 @@ Playback::Playback(std::string path, SourceOptions source_options, PlaybackOptio
       source_(path_, source_options_),
       live_(options.live.value_or(source_.live())),
       paced_(live_ && !source_.live()),
-      loop_(options.loop && !source_.live()) {}
+      loop_(options.loop && !source_.live()),
+      frame_offset_(options.frame_offset) {}
 
 std::string Playback::describe() const {
   std::ostringstream text;
@@ -40,6 +41,13 @@ std::string Playback::describe() const {
   return text.str();
 }
 
+std::string Playback::describe_losses() const {
+  std::string text = std::to_string(late_) + " skipped (late), " + std::to_string(undecodable_) +
+                     " corrupt frames skipped";
+  if (loop_) text += ", started again " + std::to_string(passes_) + " times";
+  return text;
+}
+
 double Playback::frame_period_s() const {
   return source_.fps() > 0 ? 1.0 / source_.fps() : 1.0 / 30.0;
 }
@@ -49,8 +57,12 @@ std::optional<StampedFrame> Playback::next(const WaitUntil& wait) {
     std::optional<Frame> frame = paced_ ? paced_read(wait) : source_.read();
     if (frame) {
       last_media_time_s_ = frame->media_time_s;
-      const std::int64_t stamp =
+      std::int64_t stamp =
           live_ ? frame->capture_ns : std::llround((pass_offset_s_ + frame->media_time_s) * 1e9);
+      if (frame_offset_ != 0) {
+        frame->index += frame_offset_;
+        if (source_.fps() > 0) stamp += std::llround(1e9 * frame_offset_ / source_.fps());
+      }
       return StampedFrame{std::move(*frame), stamp};
     }
     if (stopped_) return std::nullopt;  // a paced wait cut short: not the end

@@ -8,7 +8,8 @@
 // late), and a frame's stamp is the time it was due (CLOCK_REALTIME), as a camera would have
 // captured it. Cameras and network streams are never paced (they run on their own) and are stamped
 // with their capture time. Offline, a frame is stamped with its time in the source (from 0) plus
-// the length of the passes before it, so that outputs say where in the video they are.
+// the length of the passes before it, so that outputs say where in the video they are. A frame
+// offset shifts indices and stamps alike (PlaybackOptions::frame_offset).
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -23,6 +24,9 @@ struct PlaybackOptions {
   // fast as taken, stamped with its time in the source. Unset: live for cameras and streams.
   std::optional<bool> live;
   bool loop = false;  // start a file or folder again at its end (soak tests, installations)
+  // Added to every frame's index, and its period times this to every stamp: this source's frame i
+  // is the scene's frame i + frame_offset (views filmed without a common clock).
+  std::int64_t frame_offset = 0;
 };
 
 struct StampedFrame {
@@ -46,6 +50,8 @@ class Playback {
   // For logs: "file PATH, WxH, F fps, N frames, offline", with a note when an option asked for
   // cannot take effect here (decoder threads on OpenCV < 4.7).
   std::string describe() const;
+  // For logs at the end: "L skipped (late), U corrupt frames skipped[, started again P times]".
+  std::string describe_losses() const;
   bool live() const { return live_; }
   bool loops() const { return loop_; }
   std::uint64_t late_frames_passed_over() const { return late_; }
@@ -63,6 +69,7 @@ class Playback {
   SourceOptions source_options_;
   VideoSource source_;
   bool live_ = false, paced_ = false, loop_ = false, stopped_ = false;
+  std::int64_t frame_offset_ = 0;
   std::int64_t pace_start_ns_ = 0;  // when the pass's first frame was due (0: not yet)
   double pass_offset_s_ = 0.0, last_media_time_s_ = 0.0;
   std::uint64_t late_ = 0, undecodable_ = 0, passes_ = 0;

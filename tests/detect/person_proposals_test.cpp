@@ -5,7 +5,7 @@
 
 #include <algorithm>
 #include <filesystem>
-#include <memory>
+#include <optional>
 #include <stdexcept>
 #include <vector>
 
@@ -13,6 +13,7 @@
 
 #include "detect/model_files.hpp"
 #include "detect/person_proposals.hpp"
+#include "support/images.hpp"
 
 namespace mocap::detect {
 namespace {
@@ -55,31 +56,41 @@ TEST(PersonProposalTiles, TheWholeFrameComesLastWhenAdded) {
   EXPECT_EQ(proposal_tiles(1280, 720, 1, true).size(), 1u);  // one tile is the whole frame
 }
 
-// vtest.avi frame 300 (768 x 576, walkers 60-110 px tall), the golden tests' frame.
-TEST(PersonProposals, TilesFindThePeopleTheStretchedFrameFinds) {
-  const fs::path frame_file =
-      fs::path("..") / "shared" / "docs" / "models" / "movenet-multipose" / "vtest-f300.png";
-  fs::path model;
-  try {
-    model = cached_model_json("centernet");
-  } catch (const ModelMissing& e) {
-    GTEST_SKIP() << e.what();
+// The real CenterNet and a picture, or a skip naming what is absent.
+class PersonProposals : public ::testing::Test {
+ protected:
+  void load(const fs::path& image_file) {
+    fs::path model;
+    try {
+      model = cached_model_json("centernet");
+    } catch (const ModelMissing& e) {
+      GTEST_SKIP() << e.what();
+    }
+    if (!fs::exists(image_file)) GTEST_SKIP() << "picture absent: " << image_file;
+    const cv::Mat pixels = cv::imread(image_file.string());
+    ASSERT_FALSE(pixels.empty()) << image_file;
+    frame = test::image_of(pixels);
+    network.emplace(model);
   }
-  if (!fs::exists(frame_file)) GTEST_SKIP() << "reference frame absent: " << frame_file;
-  auto pixels = std::make_shared<cv::Mat>(cv::imread(frame_file.string()));
-  ASSERT_FALSE(pixels->empty());
-  const ImageBuffer frame(pixels->cols, pixels->rows, static_cast<int>(pixels->step[0]),
-                          PixelFormat::bgr8, pixels,
-                          reinterpret_cast<const std::byte*>(pixels->data));
-  CenternetNetwork network(model);
+  std::vector<Detection> propose(const ProposalOptions& options) {
+    return propose_people(*network, frame, options, input);
+  }
+
+  ImageBuffer frame;
+  std::optional<CenternetNetwork> network;
   GraphTensor input;
+};
+
+TEST_F(PersonProposals, TilesFindThePeopleTheStretchedFrameFinds) {
+  ASSERT_NO_FATAL_FAILURE(load(test::kVtestFrame300));
+  if (IsSkipped()) return;
   ProposalOptions whole;
   whole.min_score = 0.5f;
-  const auto stretched = propose_people(network, frame, whole, input);
+  const auto stretched = propose(whole);
   ASSERT_GE(stretched.size(), 3u) << "the walkers of frame 300 score 0.55-0.67";
   ProposalOptions tiled;
   tiled.tiles = 2;
-  const auto found = propose_people(network, frame, tiled, input);
+  const auto found = propose(tiled);
   for (const Detection& s : stretched) {
     bool again = false;
     for (const Detection& t : found) again = again || iou(s.box, t.box) > 0.5f;
@@ -96,29 +107,16 @@ TEST(PersonProposals, TilesFindThePeopleTheStretchedFrameFinds) {
 // COCO_val2014_000000000241 (480 x 640, portrait): the man in front is 612 px tall, taller than
 // a 480-px tile, so each tile sees only part of him; the whole-frame pass sees him whole, and
 // the merged proposals keep that box and what either pass found.
-TEST(PersonProposals, TheWholeFramePassBringsBackAPersonLargerThanTheTiles) {
-  const fs::path image_file = fs::path("..") / "shared" / "data" / "eval" /
-                              "openpose_examples_media" / "COCO_val2014_000000000241.jpg";
-  fs::path model;
-  try {
-    model = cached_model_json("centernet");
-  } catch (const ModelMissing& e) {
-    GTEST_SKIP() << e.what();
-  }
-  if (!fs::exists(image_file)) GTEST_SKIP() << "COCO still absent: " << image_file;
-  auto pixels = std::make_shared<cv::Mat>(cv::imread(image_file.string()));
-  ASSERT_FALSE(pixels->empty());
-  const ImageBuffer frame(pixels->cols, pixels->rows, static_cast<int>(pixels->step[0]),
-                          PixelFormat::bgr8, pixels,
-                          reinterpret_cast<const std::byte*>(pixels->data));
-  CenternetNetwork network(model);
-  GraphTensor input;
+TEST_F(PersonProposals, TheWholeFramePassBringsBackAPersonLargerThanTheTiles) {
+  ASSERT_NO_FATAL_FAILURE(load(fs::path("..") / "shared" / "data" / "eval" /
+                               "openpose_examples_media" / "COCO_val2014_000000000241.jpg"));
+  if (IsSkipped()) return;
   ProposalOptions whole, tiled, both;
   tiled.tiles = both.tiles = 2;
   both.whole_frame = true;
-  const auto from_whole = propose_people(network, frame, whole, input);
-  const auto from_tiles = propose_people(network, frame, tiled, input);
-  const auto merged = propose_people(network, frame, both, input);
+  const auto from_whole = propose(whole);
+  const auto from_tiles = propose(tiled);
+  const auto merged = propose(both);
   const Box2D front{126, 4, 206, 612};  // the hand-checked box (tests/data/detection)
   const auto finds = [&](const std::vector<Detection>& found, const Box2D& box) {
     return std::any_of(found.begin(), found.end(),

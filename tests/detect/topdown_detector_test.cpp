@@ -9,7 +9,6 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -21,14 +20,14 @@
 #include "detect/model_files.hpp"
 #include "detect/person_proposals.hpp"
 #include "detect/topdown_detector.hpp"
+#include "support/images.hpp"
 
 namespace mocap::detect {
 namespace {
 
 namespace fs = std::filesystem;
 
-const fs::path kFrame =
-    fs::path("..") / "shared" / "docs" / "models" / "movenet-multipose" / "vtest-f300.png";
+const fs::path& kFrame = test::kVtestFrame300;
 
 struct Models {
   fs::path lightning, centernet;
@@ -56,32 +55,35 @@ ImageBuffer shifted_frame(int shift) {
   cv::Mat moved;
   const cv::Mat m = (cv::Mat_<double>(2, 3) << 1, 0, shift, 0, 1, 0);
   cv::warpAffine(frame, moved, m, frame.size());
-  auto owner = std::make_shared<cv::Mat>(moved);
-  return ImageBuffer(moved.cols, moved.rows, static_cast<int>(moved.step[0]), PixelFormat::bgr8,
-                     owner, reinterpret_cast<const std::byte*>(owner->data));
+  return test::image_of(moved);
 }
 
-std::vector<std::vector<MovenetPerson>> run_frames(int workers, TopDownProfile& profile) {
-  std::string why;
-  const auto m = models(why);
-  TopDownOptions o;
-  o.detect_every = 3;
-  o.backend = Backend::automatic;
-  o.workers = workers;
-  TopDownDetector detector(o, m->lightning, m->centernet);
-  if (workers > 1) detector.warm_up();  // one copy builds its shapes on the frames
-  std::vector<std::vector<MovenetPerson>> out;
-  for (int i = 0; i < 5; ++i) out.push_back(detector.detect(shifted_frame(2 * i)));
-  profile = detector.profile();
+struct Frames {
+  std::vector<std::vector<MovenetPerson>> people;  // per frame
+  TopDownProfile profile;
+};
+
+// The first `frames` frames of the moving picture (2 px a frame) through a detector with `o`.
+Frames run(const Models& m, const TopDownOptions& o, int frames) {
+  TopDownDetector detector(o, m.lightning, m.centernet);
+  if (o.workers > 1) detector.warm_up();  // one copy builds its shapes on the frames
+  Frames out;
+  for (int i = 0; i < frames; ++i) out.people.push_back(detector.detect(shifted_frame(2 * i)));
+  out.profile = detector.profile();
   return out;
 }
 
 TEST(TopDownDetector, TwoWorkersFindWhatOneFinds) {
   std::string why;
-  if (!models(why)) GTEST_SKIP() << why;
-  TopDownProfile one_profile, two_profile;
-  const auto one = run_frames(1, one_profile);
-  const auto two = run_frames(2, two_profile);
+  const auto m = models(why);
+  if (!m) GTEST_SKIP() << why;
+  TopDownOptions o;
+  o.detect_every = 3;
+  o.workers = 1;
+  const Frames one_run = run(*m, o, 5);
+  o.workers = 2;
+  const Frames two_run = run(*m, o, 5);
+  const auto &one = one_run.people, &two = two_run.people;
   ASSERT_EQ(one.size(), two.size());
   for (std::size_t f = 0; f < one.size(); ++f) {
     SCOPED_TRACE(f);
@@ -98,7 +100,7 @@ TEST(TopDownDetector, TwoWorkersFindWhatOneFinds) {
       }
     }
   }
-  for (const TopDownProfile* p : {&one_profile, &two_profile}) {
+  for (const TopDownProfile* p : {&one_run.profile, &two_run.profile}) {
     EXPECT_EQ(p->frames, 5);
     EXPECT_EQ(p->detector_runs, 2);  // frames 0 and 3: nobody is lost
     EXPECT_GE(p->crops, 20);
@@ -119,18 +121,11 @@ TEST(TopDownDetector, ABoxTheDetectorIsSureOfIsAPersonWhateverItsKeypoints) {
   o.min_keypoints = 17;
   o.min_keypoint_score = 0.6f;
   o.detect_every = 10;
-  const auto run = [&](float sure, long long& detector_runs) {
-    o.sure_box_score = sure;
-    TopDownDetector detector(o, m->lightning, m->centernet);
-    std::vector<std::vector<MovenetPerson>> out;
-    for (int i = 0; i < 3; ++i) out.push_back(detector.detect(shifted_frame(2 * i)));
-    detector_runs = detector.detector_runs();
-    return out;
-  };
-  long long strict_runs = 0, sure_runs = 0;
-  const auto strict = run(0.0f, strict_runs);
-  const auto sure = run(0.5f, sure_runs);
-  EXPECT_LE(strict.front().size(), 1u) << "the strict test should reject frame 300's crops";
+  const Frames strict = run(*m, o, 3);
+  o.sure_box_score = 0.5f;
+  const Frames sure_run = run(*m, o, 3);
+  const auto& sure = sure_run.people;
+  EXPECT_LE(strict.people.front().size(), 1u) << "the strict test should reject frame 300's crops";
   // CenterNet's own boxes scoring 0.5 or more on the first frame.
   CenternetNetwork network(m->centernet);
   GraphTensor input;
@@ -151,7 +146,7 @@ TEST(TopDownDetector, ABoxTheDetectorIsSureOfIsAPersonWhateverItsKeypoints) {
       for (const Keypoint2D& k : p.keypoints)
         EXPECT_TRUE(std::isnan(k.x) || k.confidence >= o.min_keypoint_score);
   }
-  EXPECT_EQ(sure_runs, 1) << "nobody sure is lost between detector runs";
+  EXPECT_EQ(sure_run.profile.detector_runs, 1) << "nobody sure is lost between detector runs";
 }
 
 TEST(TopDownDetector, PartOfABatchEqualsThatPartOfTheWholeRun) {
@@ -175,26 +170,19 @@ TEST(TopDownDetector, PartOfABatchEqualsThatPartOfTheWholeRun) {
   EXPECT_THROW(network.run(batch, 4, 2, part), std::invalid_argument);
 }
 
-// Frames 0..5 of the moving picture with the keypoint network every `keypoint_every` frames.
-std::vector<std::vector<MovenetPerson>> run_carried(int keypoint_every, TopDownProfile& profile) {
-  std::string why;
-  const auto m = models(why);
-  TopDownOptions o;
-  o.detect_every = 3;
-  o.keypoint_every = keypoint_every;
-  TopDownDetector detector(o, m->lightning, m->centernet);
-  std::vector<std::vector<MovenetPerson>> out;
-  for (int i = 0; i < 6; ++i) out.push_back(detector.detect(shifted_frame(2 * i)));
-  profile = detector.profile();
-  return out;
-}
-
+// Frames 0..5 of the moving picture with the keypoint network every frame, then every third.
 TEST(TopDownDetector, KeypointsCarriedByFlowStayWithTheNetworksBetweenPasses) {
   std::string why;
-  if (!models(why)) GTEST_SKIP() << why;
-  TopDownProfile every_profile, carried_profile;
-  const auto every = run_carried(1, every_profile);
-  const auto carried = run_carried(3, carried_profile);
+  const auto m = models(why);
+  if (!m) GTEST_SKIP() << why;
+  TopDownOptions o;
+  o.detect_every = 3;
+  o.keypoint_every = 1;
+  const Frames every_run = run(*m, o, 6);
+  o.keypoint_every = 3;
+  const Frames carried_run = run(*m, o, 6);
+  const auto &every = every_run.people, &carried = carried_run.people;
+  const TopDownProfile &every_profile = every_run.profile, &carried_profile = carried_run.profile;
   EXPECT_EQ(every_profile.carried, 0);
   EXPECT_EQ(every_profile.flow, 0.0);
   // Passes on frames 0 and 3, flow on 1, 2, 4 and 5 for everyone the flow keeps.
@@ -235,10 +223,8 @@ TEST(TopDownDetector, APersonWhoseFlowFailsGetsAKeypointPass) {
   ASSERT_GE(first.size(), 4u);
   // A blank picture (the camera covered): no point can be followed, so nobody is carried; each
   // gets a crop instead (which shows nobody).
-  auto blank = std::make_shared<cv::Mat>(576, 768, CV_8UC3, cv::Scalar(128, 128, 128));
-  const auto second = detector.detect(
-      ImageBuffer(blank->cols, blank->rows, static_cast<int>(blank->step[0]), PixelFormat::bgr8,
-                  blank, reinterpret_cast<const std::byte*>(blank->data)));
+  const auto second =
+      detector.detect(test::image_of(cv::Mat(576, 768, CV_8UC3, cv::Scalar(128, 128, 128))));
   EXPECT_TRUE(second.empty());
   const TopDownProfile& p = detector.profile();
   EXPECT_EQ(p.carried, 0);

@@ -21,7 +21,7 @@ constexpr int kFrames = 90;
 constexpr int kCameras = 4;
 
 struct Scene {
-  std::vector<eval::SceneCamera> rig;
+  std::vector<camera::Camera> rig;
   std::vector<eval::SceneFrame> frames;
   std::vector<multiview::FrameObservations> input;
   std::vector<multiview::FrameResult> results;
@@ -79,7 +79,7 @@ double worst_bone_std_m(const std::vector<multiview::FrameResult>& results) {
 
 MultiViewFitOptions options_for(const Scene& s) {
   MultiViewFitOptions o;
-  o.cameras = scene_cameras(s.rig);
+  o.cameras = s.rig;
   o.fit = multiview_fit_defaults();
   o.fit.ground = GroundPlane{{0.0, 1.0, 0.0}, 0.0};  // the scene's floor: y = 0, y up
   return o;
@@ -117,7 +117,7 @@ TEST(MultiViewFit, ExactKeypointsGiveTheTruthBack) {
   const auto people = test::scene_people(1, 30);
   const auto rig = test::scene_rig(kCameras, 4);
   MultiViewFitOptions options;
-  options.cameras = scene_cameras(rig);
+  options.cameras = rig;
   options.fit = multiview_fit_defaults();
   std::vector<MultiViewFrameInput> frames(30);
   for (int f = 0; f < 30; ++f) {

@@ -11,6 +11,7 @@
 
 #include "eval/multiview_scene.hpp"
 #include "multiview/reconstructor.hpp"
+#include "multiview/rig_reconstruction.hpp"
 #include "support/shared_data.hpp"
 
 namespace mocap::test {
@@ -59,15 +60,15 @@ inline std::vector<eval::ScenePerson> scene_people(int count, int frames = 150,
 // `cameras` cameras of a ring of max(cameras, ring) evenly spaced ones: two cameras of a ring of
 // four are 90 degrees apart, as a two-camera rig would be set up (opposite cameras see depth
 // along their axis poorly).
-inline std::vector<eval::SceneCamera> scene_rig(int cameras, int ring = 0) {
+inline std::vector<camera::Camera> scene_rig(int cameras, int ring = 0) {
   auto rig = eval::ring_rig(std::max(cameras, ring), 6.0, 1.6, 0.9, {0.0, 1.0, 0.0}, eval::Image{});
   rig.resize(static_cast<std::size_t>(cameras));
   return rig;
 }
 
-inline std::vector<multiview::ViewGeometry> geometries(const std::vector<eval::SceneCamera>& rig) {
+inline std::vector<multiview::ViewGeometry> geometries(const std::vector<camera::Camera>& rig) {
   std::vector<multiview::ViewGeometry> out;
-  for (const auto& c : rig) out.push_back(c.geometry());
+  for (const auto& c : rig) out.push_back(multiview::from_camera(c));
   return out;
 }
 

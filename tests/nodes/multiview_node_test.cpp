@@ -30,15 +30,9 @@ constexpr int kCameras = 4;
 camera::Rig scene_camera_rig() {
   camera::Rig rig;
   int i = 0;
-  for (const eval::SceneCamera& s : scene_rig(kCameras)) {
-    camera::Camera c;
+  for (camera::Camera c : scene_rig(kCameras)) {
     c.name = "cam_" + std::to_string(i++);
-    c.width = s.width;
-    c.height = s.height;
-    c.fx = s.K[0][0], c.fy = s.K[1][1], c.cx = s.K[2][0], c.cy = s.K[2][1];
     c.distortion = {-0.05, 0.01, 0.0, 0.0};  // the node must undistort
-    c.rotation = s.R;
-    c.translation = s.t;
     rig.cameras.push_back(c);
   }
   return rig;

@@ -86,6 +86,20 @@ TEST(VideoSourceNode, OfflineSendsEveryFrameStampedWithItsTimeInTheVideo) {
   EXPECT_EQ(src.stats().drops, 0u);
 }
 
+TEST(VideoSourceNode, AFrameOffsetShiftsFrameNumbersAndTimes) {
+  if (!fs::exists(kVtestPart)) GTEST_SKIP() << "shared video absent: " << kVtestPart;
+  Harness src("source.video",
+              {{"path", kVtestPart}, {"mode", "offline"}, {"frame_offset", "5"}, {"count", "3"}});
+  src.run_source(10);
+  const auto frames = src.pull<VideoFrame>("frames");
+  ASSERT_EQ(frames.size(), 3u);
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    EXPECT_EQ(frames[i]->header.seq, i);  // the sequence counts what was sent
+    EXPECT_EQ(frames[i]->header.frame, static_cast<std::int64_t>(i) + 5);
+    EXPECT_NEAR(static_cast<double>(frames[i]->header.capture_ns) * 1e-9, 0.1 * (i + 5), 0.011);
+  }
+}
+
 TEST(VideoSourceNode, AModeThatIsNoChoiceIsRefusedBeforeOpening) {
   try {
     Harness src("source.video", {{"path", kVtestPart}, {"mode", "Live"}});

@@ -40,7 +40,7 @@ inline PeopleRigScene make_people_rig_scene(const std::vector<eval::ScenePerson>
                                             std::uint64_t seed) {
   const auto ring = eval::ring_rig(cameras, 4.5, 1.6, 0.8, {0.0, 1.0, 0.0}, eval::Image{});
   PeopleRigScene s;
-  s.truth = eval::scene_cameras(ring);
+  s.truth = ring;
   eval::SceneRenderer renderer(ring, seed);
   s.views.resize(ring.size());
   s.who.resize(ring.size());

@@ -1,6 +1,6 @@
 // video::Playback: a looped folder goes on stamping where the previous pass ended; a paced folder
 // is stamped with the times its frames were due, passes over the frames a slow reader is late for,
-// and a wait cut short (a stop) is not taken for the end.
+// and a wait cut short (a stop) is not taken for the end; a frame offset shifts indices and stamps.
 
 #include "video/playback.hpp"
 
@@ -57,6 +57,21 @@ TEST(Playback, ALoopedFolderStampsEachPassAfterThePreviousOne) {
   for (std::size_t i = 0; i < stamps.size(); ++i)
     EXPECT_EQ(stamps[i], static_cast<std::int64_t>(i) * 100 * kMs) << "frame " << i;
   EXPECT_EQ(playback.passes_started_again(), 2u);
+  EXPECT_EQ(playback.describe_losses(),
+            "0 skipped (late), 0 corrupt frames skipped, started again 2 times");
+}
+
+TEST(Playback, AFrameOffsetShiftsIndicesAndStampsAlike) {
+  const test::TempDir dir;
+  Playback playback(image_folder(dir, 3), at_fps(10.0), {.live = false, .frame_offset = -2});
+  for (std::int64_t i = 0; i < 3; ++i) {
+    const auto frame = playback.next(sleep_until);
+    ASSERT_TRUE(frame);
+    EXPECT_EQ(frame->frame.index, i - 2);
+    EXPECT_EQ(frame->stamp_ns, (i - 2) * 100 * kMs) << "frame " << i;
+  }
+  EXPECT_FALSE(playback.next(sleep_until));
+  EXPECT_EQ(playback.describe_losses(), "0 skipped (late), 0 corrupt frames skipped");
 }
 
 TEST(Playback, AFolderEndsAfterOnePassWithoutLoop) {

@@ -25,6 +25,7 @@
 #include "core/input_error.hpp"
 #include "eval/multiview_scene.hpp"
 #include "fit/scene_fit.hpp"
+#include "multiview/rig_reconstruction.hpp"
 #include "posedb/builder.hpp"
 
 namespace {
@@ -52,7 +53,7 @@ struct Variant {
 
 struct Scene {
   int views = 0;
-  std::vector<eval::SceneCamera> rig;
+  std::vector<camera::Camera> rig;
   std::vector<eval::SceneFrame> frames;
   std::vector<multiview::FrameObservations> input;
   std::vector<multiview::ViewGeometry> geometry;
@@ -107,7 +108,7 @@ Scene render(const std::vector<eval::ScenePerson>& people, int views, int frames
   s.views = views;
   auto rig = eval::ring_rig(std::max(views, 4), 6.0, 1.6, 0.9, {0.0, 1.0, 0.0}, eval::Image{});
   rig.resize(static_cast<std::size_t>(views));
-  for (const auto& c : rig) s.geometry.push_back(c.geometry());
+  for (const auto& c : rig) s.geometry.push_back(multiview::from_camera(c));
   s.rig = rig;
   eval::SceneRenderer renderer(rig, 1);
   eval::SceneDegradation d;
@@ -194,7 +195,7 @@ FitPass run_fit(const Scene& scene, const Variant& ours, int people, bool live,
   for (std::size_t f = 0; f < scene.input.size(); ++f)
     results.push_back(reconstructor.process(scene.input[f], static_cast<std::int64_t>(f)));
   fit::MultiViewFitOptions fit_options;
-  fit_options.cameras = fit::scene_cameras(scene.rig);
+  fit_options.cameras = scene.rig;
   fit_options.fit = fit::multiview_fit_defaults();
   fit_options.fit.ground = GroundPlane{{0.0, 1.0, 0.0}, 0.0};  // the scene's floor, y up
   for (const std::string& s : fit_settings) set_fit_option(fit_options, s);

@@ -194,7 +194,9 @@ int pose2sim_eval_command(int argc, char** argv) {
             "Pose2Sim's demo (issue 19 report 1): our multi-view reconstruction of its BODY_25B "
             "JSON with its\ncalibration against Pose2Sim's own triangulated TRC, per marker: "
             "median and mean distance, views\nused, reprojection errors (ours and the TRC's), "
-            "limb-length std over the trial, with and\nwithout the skeleton fit on all views.");
+            "limb-length std over the trial, with and\nwithout the skeleton fit on all views; the "
+            "hip width, and per marker the views each\ntriangulation left out and how far the "
+            "fit moved the point.");
   args.option("trial", "DIR", "Pose2Sim trial folder (pose/camXX_json, pose-3d/*.trc)",
               "../shared/data/eval/pose2sim_demo/S00_P00_T01_BalancingTrial")
       .option("calibration", "FILE", "its calibration (Pose2Sim TOML)",
@@ -215,6 +217,8 @@ int pose2sim_eval_command(int argc, char** argv) {
               {"reference", c.reference},
               {"frames", c.frames},
               {"trc_limb_std_mm", 1000 * eval::limb_std_m(c.trc_limb_lengths)},
+              {"trc_hip_width_median_mm", 1000 * eval::median_of(c.trc_hip_width_m)},
+              {"cameras", c.cameras},
               {"runs", json::array()}};
   const auto number = [](float v) { return std::isfinite(v) ? json(v) : json(nullptr); };
   for (const auto& r : c.runs) {
@@ -222,6 +226,8 @@ int pose2sim_eval_command(int argc, char** argv) {
                 {"frames_with_participant", r.frames_with_participant},
                 {"other_people", r.other_people},
                 {"limb_std_mm", number(1000 * eval::limb_std_m(r.limb_lengths))},
+                {"hip_width_median_mm", number(1000 * eval::median_of(r.hip_width_m))},
+                {"hip_width_std_mm", number(1000 * eval::limb_std_m({r.hip_width_m}))},
                 {"markers", json::object()}};
     for (std::size_t m = 0; m < c.markers.size(); ++m) {
       const auto& s = r.markers[m];
@@ -231,7 +237,10 @@ int pose2sim_eval_command(int argc, char** argv) {
           {"views_used", number(eval::mean_of(s.views))},
           {"error_used_px", number(eval::mean_of(s.error_used_px))},
           {"error_all_px", number(eval::mean_of(s.error_all_px))},
-          {"trc_error_all_px", number(eval::mean_of(s.trc_error_all_px))}};
+          {"trc_error_all_px", number(eval::mean_of(s.trc_error_all_px))},
+          {"views_left_out", s.left_out},
+          {"left_out_error_median_px", number(eval::median_of(s.left_out_error_px))},
+          {"from_triangulated_median_mm", number(1000 * eval::median_of(s.from_triangulated_m))}};
     }
     out["runs"].push_back(std::move(run));
   }

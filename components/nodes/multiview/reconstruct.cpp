@@ -15,6 +15,7 @@
 #include "fit/multiview_people_fitter.hpp"
 #include "graph/registry.hpp"
 #include "multiview/rig_reconstruction.hpp"
+#include "nodes/multiview/reconstruct_params.hpp"
 
 namespace mocap::nodes {
 using namespace mocap::graph;
@@ -28,54 +29,17 @@ class MultiViewReconstructNode : public Node {
     c.output<People3D>("out", "people in the rig's world: track ids, 15 joints in metres");
     c.join({{"view"}, SyncKey::frame, 64});
     c.required_param<std::string>("rig", "rig file: Pose2Sim/anipose TOML or OpenCV YAML");
-    c.param_list<double>("volume", {},
-                         "capture volume xmin,ymin,zmin,xmax,ymax,zmax (world, metres): people "
-                         "outside are left out and counted; empty: everywhere");
-    c.param<double>("fps", 30.0, "frame rate: tracks predict and expire in seconds",
-                    {0.1, 10000.0});
-    c.param<bool>("report_tentative", false, "report people from their first frame");
-    c.param_choice("fit", "off", {"off", "live", "full"},
-                   "skeleton fit on all views: off (triangulated joints), live (fixed lag; a new "
-                   "person's first bone_frames frames held) or full (windows, offline)");
-    c.param<int>("lag", 3, "live fit: frames of look-ahead before a frame is output", {0, 100});
-    c.param<int>("bone_frames", 30, "live fit: a new person's frames that give the bone lengths",
-                 {1, 10000});
-    c.param<int>("window", 300, "full fit: frames solved together", {2, 100000});
-    c.param<int>("overlap", 30, "full fit: frames of a window solved again with the next",
-                 {0, 99999});
-    c.param<int>("max_missed", 10, "fit: frames a person may be missing before their fit ends",
-                 {0, 10000});
+    declare_reconstruction_params(c);  // volume, fps, report_tentative
+    declare_multiview_fit_params(c);   // fit, lag, bone_frames, window, overlap, max_missed
   }
 
   void open(Context& ctx) override {
     const std::string file = ctx.param<std::string>("rig");
-    multiview::ReconstructionOptions options;
-    const auto volume = ctx.param<std::vector<double>>("volume");
-    if (!volume.empty() && volume.size() != 6)
-      throw InputError(ctx.node_name() + ".volume",
-                       "expected 6 numbers (xmin,ymin,zmin,xmax,ymax,zmax), got " +
-                           std::to_string(volume.size()));
-    if (volume.size() == 6) {
-      options.volume_min = glm::vec3(volume[0], volume[1], volume[2]);
-      options.volume_max = glm::vec3(volume[3], volume[4], volume[5]);
-    }
-    options.tracker.fps = ctx.param<double>("fps");
-    options.report_tentative = ctx.param<bool>("report_tentative");
+    const multiview::ReconstructionOptions options = read_reconstruction_params(ctx);
     // Live cameras' frame counters are unrelated: the sets are numbered here instead.
     number_sets_ = ctx.param<std::string>("sync_by") == "capture_time";
     solver_ = std::make_unique<multiview::RigReconstruction>(camera::read_rig(file), file, options);
-    if (const auto mode = ctx.param<std::string>("fit"); mode != "off") {
-      fit::MultiViewPeopleFitOptions o;
-      o.mode = mode == "full" ? fit::StreamFitMode::full : fit::StreamFitMode::live;
-      o.fit.cameras = solver_->rig().cameras;
-      o.fit.fit = fit::multiview_fit_defaults();
-      o.fit.fit.ground = solver_->floor();
-      o.fit.fit.lag = ctx.param<int>("lag");
-      o.fit.bone_frames = ctx.param<int>("bone_frames");
-      o.window = {ctx.param<int>("window"), ctx.param<int>("overlap")};
-      o.max_missed = ctx.param<int>("max_missed");
-      fitter_.emplace(std::move(o));
-    }
+    if (auto fit = read_multiview_fit_params(ctx, *solver_)) fitter_.emplace(std::move(*fit));
     views_.resize(ctx.input_count("view"));
     if (views_.size() > solver_->rig().cameras.size())
       throw InputError(file, std::to_string(views_.size()) + " views but " +

@@ -6,7 +6,6 @@
 // A file, or a file served over HTTP/RTSP, that stops well before the frames its container
 // announces stops the graph with an error naming the input (the run ends incomplete, exit 1).
 
-#include <cmath>
 #include <iostream>
 #include <optional>
 
@@ -55,12 +54,13 @@ class VideoSourceNode : public Node {
     options.timeout_ms = ctx.param<int>("timeout_ms");
     const auto path = ctx.param<std::string>("path");
     const auto mode = ctx.param<std::string>("mode");  // a choice: checked before open()
-    video::PlaybackOptions playback{.live = {}, .loop = ctx.param<bool>("loop")};
+    video::PlaybackOptions playback{.live = {},
+                                    .loop = ctx.param<bool>("loop"),
+                                    .frame_offset = ctx.param<std::int64_t>("frame_offset")};
     if (mode != "auto") playback.live = mode == "live";
     playback_.emplace(path, options, playback);
     count_ = ctx.param<std::uint64_t>("count");
     camera_ = ctx.param<std::string>("camera");
-    offset_ = ctx.param<std::int64_t>("frame_offset");
     stream_ = ctx.param<std::string>("stream");
     if (stream_.empty()) stream_ = path;
     std::cerr << ctx.node_name() << ": " << playback_->describe() << "\n";
@@ -77,9 +77,7 @@ class VideoSourceNode : public Node {
       return;
     }
     VideoFrame message;
-    message.header = {stream_, sent_, frame->stamp_ns, frame->frame.index + offset_};
-    if (offset_ != 0 && playback_->source().fps() > 0)
-      message.header.capture_ns += std::llround(1e9 * offset_ / playback_->source().fps());
+    message.header = {stream_, sent_, frame->stamp_ns, frame->frame.index};
     message.camera = camera_;
     message.image = std::move(frame->frame.image);
     ctx.send("frames", std::move(message));
@@ -89,11 +87,7 @@ class VideoSourceNode : public Node {
   void close(Context& ctx) override {
     if (!playback_) return;
     std::cerr << ctx.node_name() << ": " << sent_ << " frames sent, "
-              << playback_->late_frames_passed_over() << " skipped (late), "
-              << playback_->undecodable_frames() << " corrupt frames skipped";
-    if (playback_->loops())
-      std::cerr << ", started again " << playback_->passes_started_again() << " times";
-    std::cerr << "\n";
+              << playback_->describe_losses() << "\n";
   }
 
  private:
@@ -119,7 +113,6 @@ class VideoSourceNode : public Node {
   std::optional<video::Playback> playback_;
   std::uint64_t count_ = 0, sent_ = 0, late_ = 0, undecodable_ = 0, passes_ = 0;
   std::string camera_;
-  std::int64_t offset_ = 0;
   std::string stream_;
 };
 
