@@ -246,6 +246,34 @@ double median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
+// Two views whose people sit at the same pixels show one viewpoint: the same video given twice, or
+// two cameras at one place. No baseline, no depth: the relative pose is undetermined.
+void refuse_views_without_baseline(const std::vector<ViewSightings>& views,
+                                   const std::vector<Camera>& cameras,
+                                   const std::vector<std::string>& names) {
+  for (std::size_t b = 1; b < views.size(); ++b)
+    for (std::size_t a = 0; a < b; ++a) {
+      std::vector<double> apart;
+      for (std::size_t f = 0; f < views[a].size(); ++f) {
+        const Sighting &sa = views[a][f], &sb = views[b][f];
+        if (!sa.present || !sb.present) continue;
+        for (std::size_t j = 0; j < kJoints; ++j)
+          if (sa.confidence[j] > 0 && sb.confidence[j] > 0)
+            apart.push_back(glm::distance(sa.pixel[j], sb.pixel[j]));
+      }
+      if (apart.size() < 8) continue;
+      const double m = median(apart);
+      // 0.2 % of the width: 4 px at 1920. Cameras 10 cm apart see a person 5 m away ~30 px apart.
+      if (m < 0.002 * std::max(cameras[a].width, cameras[b].width))
+        throw InputError(names[b], "sees the people at the same pixels as " + names[a] +
+                                       " (median " + fixed(m, 2) + " px apart over " +
+                                       std::to_string(apart.size()) +
+                                       " keypoints): the same video given twice, or two cameras "
+                                       "at one place; calibration needs cameras standing apart "
+                                       "(no baseline, no depth)");
+    }
+}
+
 // Head top to ankle along the bones that stack up when standing (head, trunk, thigh, shin).
 double stature_bones(const std::array<double, kJoints>& bone) {
   const auto at = [&](Joint j) { return bone[index(j)]; };
@@ -586,6 +614,7 @@ PeopleCalibration calibrate_rig_from_people(std::span<const Camera> given,
                                      " frames");
     motions.push_back(m);
   }
+  refuse_views_without_baseline(views, cameras, names);
   result.motion = median(motions);
   if (result.motion < o.min_motion)
     throw InputError("views", "the person hardly moves (keypoints spread " +
@@ -655,13 +684,14 @@ PeopleCalibration calibrate_rig_from_people(std::span<const Camera> given,
   // Metres from the bones.
   std::array<double, kJoints> bones{};
   for (std::size_t j = 0; j < kJoints; ++j) bones[j] = solved.problem.lengths[j];
-  const double stature = stature_bones(bones);
-  result.height_m =
-      o.height_m > 0 ? o.height_m : stature_bones(canonical_bones()) + kAnkleClearanceM;
+  // The standing height is kStatureOverJointSpan joint spans (measured on the CMU train
+  // subjects, motion/canonical_body.hpp).
+  const double span = stature_bones(bones);
+  result.height_m = o.height_m > 0 ? o.height_m : motion::canonical_stature_m();
   if (o.height_m <= 0)
-    result.notes.push_back("scale from the canonical body's height, " + fixed(result.height_m, 3) +
-                           " m (give --height)");
-  const double s = (result.height_m - kAnkleClearanceM) / stature;
+    result.notes.push_back("scale from the canonical body's standing height, " +
+                           fixed(result.height_m, 3) + " m (give --height)");
+  const double s = result.height_m / (motion::kStatureOverJointSpan * span);
   scale_world(cameras, points, s);
 
   const WorldFrame w = world_from_people(cameras, points, solved.frames);

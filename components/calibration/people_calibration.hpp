@@ -12,9 +12,10 @@
 //      3D joints of every frame used, with each bone's length shared by all frames and a robust
 //      loss; observations whose error exceeds outlier_factor x the median are dropped and the
 //      solve repeated;
-//   4. metres from the bones: the person's height (given, else the canonical body's) over the
-//      leg + trunk + head bones; the floor from the feet (fit::GroundEstimator), origin under the
-//      people's mean root, z up, x along the first camera's heading.
+//   4. metres from the bones: the person's standing height (given, else the canonical body's)
+//      over motion::kStatureOverJointSpan x the head + trunk + thigh + shin bones; the floor from
+//      the feet (fit::GroundEstimator), origin under the people's mean root, z up, x along the
+//      first camera's heading.
 //
 // A library of its own (not components/camera): it needs the triangulation of components/multiview
 // and the ground estimation of components/fit, which both build on components/camera.
@@ -37,7 +38,8 @@ struct PeopleCalibrationOptions {
   // of one pose are too few and too flat to fix the cameras).
   double min_motion = 0.05;
   int max_frames = 200;  // frames in the bundle adjustment, evenly spread over those usable
-  // The person's height in metres (head top to sole); 0: the canonical body's.
+  // The person's standing height in metres (floor to top of head); 0: the canonical body's
+  // (motion::canonical_stature_m()).
   double height_m = 0.0;
   double outlier_factor = 3.0;  // drop observations with error > factor x median, re-solve
   int outlier_rounds = 3;
@@ -69,7 +71,8 @@ struct PeopleCalibration {
 // views' people: views[k] is camera k's sequence, all of one length, frame i of each taken at the
 // same instant; sources[k] names the view in messages. Throws InputError naming the view or
 // camera when: the views differ in length, a view has no person, a camera shares fewer than
-// min_shared_frames frames with the others, the person hardly moves, or a camera cannot be placed.
+// min_shared_frames frames with the others, two views see the people at the same pixels (no
+// baseline), the person hardly moves, or a camera cannot be placed.
 PeopleCalibration calibrate_rig_from_people(std::span<const camera::Camera> cameras,
                                             std::span<const camera::BodySequence> views,
                                             std::span<const std::string> sources,

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
+#include <fstream>
 #include <limits>
 #include <map>
 #include <system_error>
@@ -393,6 +395,46 @@ OpenPoseSequence read_openpose_folder(const std::filesystem::path& folder,
   }
   FolderReader reader(options, first, static_cast<std::size_t>(last - first + 1));
   return reader.read(files, folder.string());
+}
+
+std::string openpose_json_text(const People2D& frame) {
+  json people = json::array();
+  for (const Person2D& p : frame.people) {
+    json keypoints = json::array();
+    for (const Keypoint2D& k : p.joints) {
+      const bool seen = k.confidence > 0.0f && std::isfinite(k.x) && std::isfinite(k.y) &&
+                        std::isfinite(k.confidence);
+      keypoints.push_back(seen ? k.x : 0.0f);
+      keypoints.push_back(seen ? k.y : 0.0f);
+      keypoints.push_back(seen ? k.confidence : 0.0f);
+    }
+    people.push_back({{"person_id", json::array({p.id})},
+                      {"pose_keypoints_2d", std::move(keypoints)},
+                      {"face_keypoints_2d", json::array()},
+                      {"hand_left_keypoints_2d", json::array()},
+                      {"hand_right_keypoints_2d", json::array()}});
+  }
+  return json{{"version", 1.3}, {"people", std::move(people)}}.dump();
+}
+
+std::filesystem::path openpose_file_name(const std::filesystem::path& folder,
+                                         const std::string& stem, std::int64_t number) {
+  char digits[32];
+  std::snprintf(digits, sizeof digits, "%012lld", static_cast<long long>(number));
+  return folder / (stem + "_" + digits + "_keypoints.json");
+}
+
+void write_openpose_file(const std::filesystem::path& file, const People2D& frame) {
+  std::filesystem::path temporary = file;
+  temporary += ".partial";
+  {
+    std::ofstream out(temporary, std::ios::binary);
+    out << openpose_json_text(frame) << "\n";
+    if (!out.flush()) throw std::runtime_error("cannot write " + temporary.string());
+  }
+  std::error_code ec;
+  std::filesystem::rename(temporary, file, ec);
+  if (ec) throw std::runtime_error("cannot write " + file.string() + ": " + ec.message());
 }
 
 }  // namespace mocap::io

@@ -106,4 +106,19 @@ OpenPoseSequence read_openpose_folder(const std::filesystem::path& folder,
 
 std::string_view to_string(FrameProblemKind kind);
 
+// The writer: one frame as OpenPose writes it (version 1.3, per person `person_id` [id] and
+// `pose_keypoints_2d` in the frame's layout; a keypoint without confidence or coordinates as
+// 0, 0, 0), which read_openpose_file reads back to the same people (25-keypoint layouts: given
+// the same Body25Choice).
+std::string openpose_json_text(const People2D& frame);
+
+// The file of frame `number` in `folder`, as OpenPose names it:
+// `<stem>_<number, 12 digits>_keypoints.json`.
+std::filesystem::path openpose_file_name(const std::filesystem::path& folder,
+                                         const std::string& stem, std::int64_t number);
+
+// Writes `frame` to `file` whole (a temporary file renamed into place: a file is complete or
+// absent). Throws std::runtime_error naming the file when it cannot be written.
+void write_openpose_file(const std::filesystem::path& file, const People2D& frame);
+
 }  // namespace mocap::io

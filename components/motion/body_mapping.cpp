@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include "core/input_error.hpp"
@@ -280,6 +281,18 @@ void body_positions(const BodyMapping& m, const GlobalPose& pose,
     if (src.local_offset != glm::vec3(0.0f)) p += pose.rotation[src.joint] * src.local_offset;
     out[b] = p * m.metres_per_unit;
   }
+}
+
+float reference_stature_m(const Clip& clip, const BodyMapping& mapping) {
+  if (!mapping.first_frame_is_reference || clip.frame_count < 1) return 0.0f;
+  const PoseSequence poses = slice(to_poses(clip), 0, 1);
+  GlobalPose pose;
+  forward_kinematics(poses, 0, pose);
+  std::array<glm::vec3, kBodyJoints> body;
+  body_positions(mapping, pose, body);
+  float lowest = std::numeric_limits<float>::max();
+  for (const glm::vec3& p : pose.position) lowest = std::min(lowest, p.y * mapping.metres_per_unit);
+  return body[index(Joint::head)].y - lowest;
 }
 
 bool is_blank_frame(const Clip& clip, int frame) {

@@ -48,6 +48,12 @@ BodyMapping map_to_body(const Skeleton& skeleton, const std::string& source);
 void body_positions(const BodyMapping& mapping, const GlobalPose& pose,
                     std::array<glm::vec3, kBodyJoints>& out);
 
+// A subject's standing height, floor to top of head (metres), from a file whose frame 0 is an
+// upright reference pose (`first_frame_is_reference`, the cgspeed CMU files' T-pose): the body's
+// head (top of the head) above the lowest joint or End Site of that frame (the toes' End Site)
+// along y (BVH up). 0 when the file has no reference frame.
+float reference_stature_m(const Clip& clip, const BodyMapping& mapping);
+
 // True when every channel value of the frame is zero: not capture data (cgspeed 07_12, 09_10).
 bool is_blank_frame(const Clip& clip, int frame);
 

@@ -57,6 +57,17 @@ BodyProportions make_canonical() {
 
 }  // namespace
 
+float joint_span_m(const BodyProportions& p) {
+  const auto bone = [&](Joint j) { return p.bone_m[index(j)]; };
+  return bone(Joint::head) + bone(Joint::neck) +
+         0.5f * (bone(Joint::right_knee) + bone(Joint::left_knee)) +
+         0.5f * (bone(Joint::right_ankle) + bone(Joint::left_ankle));
+}
+
+float canonical_stature_m() {
+  return kStatureOverJointSpan * joint_span_m(canonical_proportions());
+}
+
 float BodyProportions::shoulder_width_m() const {
   return bone_m[kRightShoulder] * std::sin(shoulder_angle_rad) +
          bone_m[kLeftShoulder] * std::sin(shoulder_angle_rad);

@@ -36,6 +36,25 @@ struct BodyProportions {
 // numbers from ../shared/data/mocap/cmu31 (measure_proportions) and checks they agree.
 const BodyProportions& canonical_proportions();
 
+// The joint span: the bones that stack up from ankle to top of head when standing (head, trunk,
+// thigh, shin; left and right averaged), metres. What a calibration from people measures of a
+// person's size (calibration/people_calibration.hpp).
+float joint_span_m(const BodyProportions& proportions);
+
+// A person's standing height (floor to top of head) over their joint span: the median over the
+// cmu31 train subjects (01, 03, 08, 09, 86, 91; the first train file of each) of the stature in
+// the subject's reference T-pose (motion::reference_stature_m: the head End Site, top of the head,
+// above the lowest toe End Site) over the joint span of that pose: 1.0123 to 1.0196, median
+// 1.0175 (stature 1.31 to 1.53 m, as ../shared/data/mocap/README.md lists the spans). It holds
+// the ankle's height over the toes and the legs' and neck's slant. The skeletons have no heel and
+// the toe End Site is not the sole, so a measured stature may be somewhat larger than this one
+// (not measured: no subject's measured height is in ../shared). Recomputed by
+// CanonicalBody.StatureOverJointSpanAgreesWithCmuTrain.
+inline constexpr float kStatureOverJointSpan = 1.0175f;
+
+// The canonical body's standing height: kStatureOverJointSpan x its joint span.
+float canonical_stature_m();
+
 // Medians over the frames of each bone length and of the shoulder angle. With `symmetric` the
 // left and right bones of a pair are pooled (one length for both sides). Frames with non-finite
 // joints are left out; all lengths are 0 when no frame is usable.

@@ -10,17 +10,38 @@
 
 #include <iostream>
 
+#include <glm/geometric.hpp>
+
 #include "core/input_error.hpp"
+#include "motion/body_mapping.hpp"
+#include "motion/bvh.hpp"
+#include "motion/canonical_body.hpp"
 #include "support/people_rig_scene.hpp"
 #include "support/shared_data.hpp"
 
 namespace mocap::calibration {
 namespace {
 
+const std::string kWalkerFile = "08_01.bvh";
+const std::string kSecondWalkerFile = "09_01.bvh";
+
 const eval::TruthSequence& walker() {
   static const std::vector<eval::TruthSequence> truth =
-      eval::load_truth({(test::shared_data() / "mocap" / "cmu31" / "08_01.bvh").string()}, 30.0);
+      eval::load_truth({(test::shared_data() / "mocap" / "cmu31" / kWalkerFile).string()}, 30.0);
   return truth.front();
+}
+
+const eval::TruthSequence& second_walker() {
+  static const std::vector<eval::TruthSequence> truth = eval::load_truth(
+      {(test::shared_data() / "mocap" / "cmu31" / kSecondWalkerFile).string()}, 30.0);
+  return truth.front();
+}
+
+// The walker's standing height, from the reference T-pose of its file.
+double walker_stature_m() {
+  const std::string file = (test::shared_data() / "mocap" / "cmu31" / kWalkerFile).string();
+  const motion::Clip clip = motion::read_bvh(file);
+  return motion::reference_stature_m(clip, motion::map_to_body(clip.skeleton, file));
 }
 
 eval::SceneDegradation detector_like() {
@@ -81,7 +102,7 @@ TEST(PeopleCalibration, AVirtualRigIsRecoveredFromAWalker) {
     EXPECT_LT(c.angle_deg[k], 0.5) << s.truth[k].name;
     EXPECT_LT(found.cameras[k].rms_px, 15.0);  // noise σ 1 % of a ~500 px person, outliers
   }
-  // Metres from the canonical body: CMU subject 8 is within 10 % of it.
+  // Metres from the canonical body's standing height: CMU subject 8 is within 10 % of it.
   std::cout << "[ measured ] scale to the truth " << c.to_truth.scale << "\n";
   EXPECT_NEAR(c.to_truth.scale, 1.0, 0.1);
   // The world: z up, the cameras 1.6 and 2.4 m above the floor (scaled as the rig is).
@@ -123,6 +144,79 @@ TEST(PeopleCalibration, ViewsOfDifferentLengthsAndACameraWithoutThePersonAreRefu
   const std::string few = refusal(s.truth, rarely);
   EXPECT_NE(few.find("cam_02"), std::string::npos) << few;
   EXPECT_NE(few.find("shares 5 frames"), std::string::npos) << few;
+}
+
+// --height is the standing height (floor to top of head): a walker of known height gives the rig at
+// its true scale, within the spread of the subjects' stature / joint span ratios (the walker's own
+// against the train median, plus the noise in its bones).
+TEST(PeopleCalibration, TheWalkersStandingHeightGivesTheTrueScale) {
+  MOCAP_REQUIRE_SHARED("mocap/cmu31/08_01.bvh");
+  const double stature = walker_stature_m();
+  ASSERT_GT(stature, 1.3);  // subject 8's T-pose: 1.43 m
+  const test::PeopleRigScene s =
+      test::make_people_rig_scene({walking_through_the_room(60)}, 3, 60, detector_like(), 13);
+  PeopleCalibrationOptions options;
+  options.height_m = stature;
+  options.max_frames = 30;     // of the 60 in each bundle adjustment: a fast test
+  options.outlier_rounds = 1;  // one re-solve after dropping outliers: a fast test
+  const PeopleCalibration found =
+      calibrate_rig_from_people(intrinsics_only(s.truth), s.views, sources(3), options);
+  const test::RigComparison c = test::compare_rigs(found.rig.cameras, s.truth);
+  std::cout << "[ measured ] standing height " << stature << " m: scale to the truth "
+            << c.to_truth.scale << "\n";
+  EXPECT_NEAR(c.to_truth.scale, 1.0, 0.03);
+  EXPECT_DOUBLE_EQ(found.height_m, stature);
+  // In metres as calibrated (no rescaling): the distance between two cameras.
+  const double baseline = glm::distance(s.truth[0].centre(), s.truth[1].centre());
+  EXPECT_NEAR(glm::distance(found.rig.cameras[0].centre(), found.rig.cameras[1].centre()), baseline,
+              0.03 * baseline);
+}
+
+// Two people walking in the room at once: each frame's person is associated across the views by
+// epipolar consistency (a view's most visible detection is often the other person), and the rig
+// comes out as well as from one walker.
+TEST(PeopleCalibration, TwoPeopleInViewAreAssociatedAcrossTheViews) {
+  MOCAP_REQUIRE_SHARED("mocap/cmu31/08_01.bvh");
+  MOCAP_REQUIRE_SHARED("mocap/cmu31/09_01.bvh");
+  std::vector<eval::ScenePerson> people(2);
+  people[0].motion = &walker();
+  people[1].motion = &second_walker();
+  eval::spread_people(people, 60, 2.0f, 1.0f, 1);
+  eval::SceneDegradation d = detector_like();
+  d.occlusion = true;  // people hide each other
+  const test::PeopleRigScene s = test::make_people_rig_scene(people, 3, 60, d, 17);
+  // Both people are seen in most views' frames: several detections per frame to choose from.
+  int frames_with_two = 0;
+  for (const auto& frame : s.views[0]) frames_with_two += frame.size() >= 2;
+  EXPECT_GT(frames_with_two, 30);
+  PeopleCalibrationOptions options;
+  options.max_frames = 30;     // of the 60 in each bundle adjustment: a fast test
+  options.outlier_rounds = 1;  // one re-solve after dropping outliers: a fast test
+  const PeopleCalibration found =
+      calibrate_rig_from_people(intrinsics_only(s.truth), s.views, sources(3), options);
+  bool associated = false;
+  for (const std::string& note : found.notes)
+    associated = associated || note.find("associated across the views") != std::string::npos;
+  EXPECT_TRUE(associated);
+  const test::RigComparison c = test::compare_rigs(found.rig.cameras, s.truth);
+  for (std::size_t k = 0; k < 3; ++k) {
+    std::cout << "[ measured ] two people, " << s.truth[k].name << ": " << 100 * c.position_m[k]
+              << " cm, " << c.angle_deg[k] << " deg, " << found.cameras[k].rms_px << " px RMS\n";
+    EXPECT_LT(c.position_m[k], 0.05) << s.truth[k].name;
+    EXPECT_LT(c.angle_deg[k], 0.5) << s.truth[k].name;
+  }
+}
+
+// The same view given twice (no baseline): refused naming both views, before any solve.
+TEST(PeopleCalibration, TheSameViewTwiceIsRefused) {
+  MOCAP_REQUIRE_SHARED("mocap/cmu31/08_01.bvh");
+  test::PeopleRigScene s =
+      test::make_people_rig_scene({walking_through_the_room(30)}, 3, 30, detector_like(), 19);
+  s.views[2] = s.views[0];
+  const std::string why = refusal(s.truth, s.views);
+  EXPECT_NE(why.find("view_3"), std::string::npos) << why;
+  EXPECT_NE(why.find("same pixels as camera cam_01 (view_1)"), std::string::npos) << why;
+  EXPECT_NE(why.find("no baseline"), std::string::npos) << why;
 }
 
 }  // namespace

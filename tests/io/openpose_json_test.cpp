@@ -165,6 +165,52 @@ TEST(OpenPoseJson, CorruptedTextNeverCrashes) {
   }
 }
 
+// What the writer writes reads back to the same people: ids, keypoints, a missing keypoint (NaN or
+// confidence 0) as OpenPose's 0, 0, 0; an empty frame stays a frame; the file name is OpenPose's.
+TEST(OpenPoseJson, WrittenFramesReadBack) {
+  TempDir dir;
+  People2D frame;
+  frame.layout = LayoutId::coco17;
+  for (int id : {-1, 4}) {
+    Person2D& p = frame.people.emplace_back();
+    p.id = id;
+    for (int j = 0; j < 17; ++j)
+      p.joints.push_back({100.25f + 10.0f * j + static_cast<float>(id), 50.5f + 3.0f * j, 0.75f});
+  }
+  frame.people[0].joints[3] = {std::nanf(""), std::nanf(""), 0.0f};
+  frame.people[1].joints[5].confidence = 0.0f;
+  const auto file = openpose_file_name(dir.path(), "cam_01", 7);
+  EXPECT_EQ(file.filename().string(), "cam_01_000000000007_keypoints.json");
+  write_openpose_file(file, frame);
+  const People2D back = read_openpose_file(file);
+  EXPECT_EQ(back.layout, LayoutId::coco17);
+  ASSERT_EQ(back.people.size(), 2u);
+  for (std::size_t i = 0; i < 2; ++i) {
+    EXPECT_EQ(back.people[i].id, frame.people[i].id);
+    ASSERT_EQ(back.people[i].joints.size(), 17u);
+    for (std::size_t j = 0; j < 17; ++j) {
+      const Keypoint2D& a = frame.people[i].joints[j];
+      const Keypoint2D& b = back.people[i].joints[j];
+      if (a.confidence > 0.0f) {
+        EXPECT_EQ(b.x, a.x);
+        EXPECT_EQ(b.y, a.y);
+        EXPECT_EQ(b.confidence, a.confidence);
+      } else {
+        EXPECT_TRUE(std::isnan(b.x)) << i << " " << j;
+        EXPECT_EQ(b.confidence, 0.0f);
+      }
+    }
+  }
+  People2D nobody;
+  nobody.layout = LayoutId::coco17;
+  write_openpose_file(openpose_file_name(dir.path(), "cam_01", 8), nobody);
+  const OpenPoseSequence folder = read_openpose_folder(dir.path());
+  ASSERT_EQ(folder.frames.size(), 2u);
+  EXPECT_TRUE(folder.frames[1].people.empty());
+  EXPECT_TRUE(folder.problems.empty());
+  EXPECT_FALSE(std::filesystem::exists(file.string() + ".partial"));
+}
+
 TEST(OpenPoseJson, FrameNumbers) {
   EXPECT_EQ(frame_number("video_000000000123_keypoints.json"), 123);
   EXPECT_EQ(frame_number("cam01.0042.json"), 42);

@@ -161,6 +161,47 @@ TEST(CanonicalBody, ConstantsAgreeWithCmuTrain) {
   EXPECT_NEAR(c.hip_width_m(), 0.151f, 0.003f);
 }
 
+// Standing height over joint span per train subject, from each subject's first train file's
+// reference T-pose (frame 0 of the cgspeed files; every file of a subject has one skeleton).
+TEST(CanonicalBody, StatureOverJointSpanAgreesWithCmuTrain) {
+  MOCAP_REQUIRE_SHARED("mocap/cmu31/splits.txt");
+  std::ifstream list(test::shared_data() / "mocap/cmu31/splits.txt");
+  std::vector<std::string> subjects, files;
+  std::string which, file;
+  while (list >> which >> file) {
+    const std::string subject = file.substr(0, file.find('_'));
+    if (which != "train" || std::count(subjects.begin(), subjects.end(), subject)) continue;
+    subjects.push_back(subject);
+    files.push_back((test::shared_data() / "mocap/cmu31" / file).string());
+  }
+  ASSERT_EQ(subjects.size(), 6u);
+  std::vector<float> ratios;
+  std::cout << "| subject | stature m | joint span m | ratio |\n|---|---:|---:|---:|\n";
+  for (std::size_t i = 0; i < files.size(); ++i) {
+    const Clip clip = read_bvh(files[i]);
+    const BodyMapping m = map_to_body(clip.skeleton, files[i]);
+    const float stature = reference_stature_m(clip, m);
+    const PoseSequence first = slice(to_poses(clip), 0, 1);
+    GlobalPose g;
+    forward_kinematics(first, 0, g);
+    Body15 b;
+    body_positions(m, g, b);
+    const float span = joint_span_m(proportions_of(b));
+    ratios.push_back(stature / span);
+    std::cout << "| " << subjects[i] << " | " << stature << " | " << span << " | " << ratios.back()
+              << " |\n";
+    // As ../shared/data/mocap/README.md lists the T-pose spans (1.31 to 1.53 m).
+    EXPECT_GT(stature, 1.3f) << files[i];
+    EXPECT_LT(stature, 1.55f) << files[i];
+    EXPECT_GT(stature, span) << files[i];
+  }
+  std::sort(ratios.begin(), ratios.end());
+  const float median = 0.5f * (ratios[2] + ratios[3]);
+  std::cout << "median ratio " << median << "; canonical stature " << canonical_stature_m()
+            << " m\n";
+  EXPECT_NEAR(median, kStatureOverJointSpan, 0.001f);
+}
+
 TEST(CanonicalBody, BandaiOnTheCanonicalBody) {
   MOCAP_REQUIRE_SHARED("mocap/bandai/dataset-1/dataset-1_walk_normal_001.bvh");
   const auto frames = bodies_of(

@@ -25,6 +25,8 @@
 #include "core/input_error.hpp"
 #include "eval/multiview_protocol.hpp"
 #include "io/openpose_json.hpp"
+#include "motion/body_mapping.hpp"
+#include "motion/bvh.hpp"
 #include "support/people_rig_scene.hpp"
 
 namespace {
@@ -95,8 +97,16 @@ double mpjpe_mm(const std::vector<std::vector<eval::Body>>& found, const test::P
   return n ? 1000 * sum / n : std::nan("");
 }
 
+// The standing height of the subject of a cgspeed file, from its reference T-pose.
+double stature_of(const std::string& file) {
+  const motion::Clip clip = motion::read_bvh(file);
+  return motion::reference_stature_m(clip, motion::map_to_body(clip.skeleton, file));
+}
+
+// true_height: each walker alone is given its own standing height (--height) instead of the
+// canonical body's (the walkers together have no one height: left out).
 void virtual_cases(const fs::path& cmu, int frames, const std::vector<double>& noises,
-                   bool together_only) {
+                   bool together_only, bool true_height) {
   const std::vector<std::string> clips = {"02_01.bvh", "07_01.bvh", "07_05.bvh", "07_12.bvh"};
   std::vector<std::string> files;
   for (const auto& c : clips) files.push_back((cmu / c).string());
@@ -113,6 +123,7 @@ void virtual_cases(const fs::path& cmu, int frames, const std::vector<double>& n
     for (double noise : noises) {
       const bool together = i == truth.size();
       if (together_only && !together) continue;
+      if (true_height && together) continue;
       std::vector<eval::ScenePerson> people(together ? 3 : 1);
       for (std::size_t p = 0; p < people.size(); ++p) people[p].motion = &truth[together ? p : i];
       eval::spread_people(people, frames, 2.0f, 1.0f, 1);
@@ -123,14 +134,20 @@ void virtual_cases(const fs::path& cmu, int frames, const std::vector<double>& n
       d.occlusion = together;
       d.false_detections = together ? 0.2f : 0.0f;
       const test::PeopleRigScene s = test::make_people_rig_scene(people, 4, frames, d, 11 + i);
-      const std::string label = together ? "3 walkers together" : truth[i].clip;
+      calibration::PeopleCalibrationOptions options;
+      if (true_height) options.height_m = stature_of(files[i]);
+      const std::string label =
+          together ? "3 walkers together"
+          : true_height
+              ? truth[i].clip + " (--height " + std::to_string(options.height_m).substr(0, 5) + ")"
+              : truth[i].clip;
       std::vector<camera::Camera> intrinsics = s.truth;
       for (camera::Camera& c : intrinsics) c.rotation = glm::dmat3(1.0), c.translation = {};
       std::vector<std::string> sources = {"view_1", "view_2", "view_3", "view_4"};
       const auto start = std::chrono::steady_clock::now();
       try {
         const calibration::PeopleCalibration found =
-            calibration::calibrate_rig_from_people(intrinsics, s.views, sources);
+            calibration::calibrate_rig_from_people(intrinsics, s.views, sources, options);
         const double took = seconds_since(start);
         const test::RigComparison c = test::compare_rigs(found.rig.cameras, s.truth);
         double position = 0, angle = 0;
@@ -165,7 +182,9 @@ int main(int argc, char** argv) {
               "0.01,0.02", cli::Range::positive_list())
       .flag("skip-virtual", "only the demo")
       .flag("skip-demo", "only the virtual scenes")
-      .flag("together-only", "of the virtual scenes, only the walkers together");
+      .flag("together-only", "of the virtual scenes, only the walkers together")
+      .flag("true-height",
+            "give each walker alone its own standing height (its file's T-pose) as --height");
   int code = 0;
   if (!args.parse(argc - 1, argv + 1, code)) return code;
   try {
@@ -174,7 +193,7 @@ int main(int argc, char** argv) {
                     args.has("aligned") ? fs::path(args.get("aligned")) : fs::path());
     if (!args.has("skip-virtual"))
       virtual_cases(args.get("cmu"), static_cast<int>(args.integer("frames")),
-                    args.numbers("noise"), args.has("together-only"));
+                    args.numbers("noise"), args.has("together-only"), args.has("true-height"));
   } catch (const std::exception& e) {
     std::cerr << "mocap-bench-people-rig: " << e.what() << "\n";
     return 1;

@@ -34,9 +34,12 @@
 #include "cli_args.hpp"
 #include "commands.hpp"
 #include "core/input_error.hpp"
+#include "detector_presets.hpp"
 #include "eval/layout_calibration.hpp"
 #include "eval_report.hpp"
 #include "io/openpose_json.hpp"
+#include "motion/canonical_body.hpp"
+#include "people_views.hpp"
 #include "progress_bar.hpp"
 
 namespace mocap::cli {
@@ -481,23 +484,32 @@ Range outlier_range() {
 }
 
 // `mocap calibrate rig --from-people`: the extrinsics from the people the views show
-// (calibration/people_calibration.hpp).
+// (calibration/people_calibration.hpp); videos and image folders through the detector first
+// (people_views.hpp).
 int rig_people_command(int argc, char** argv) {
   Args args(
-      "mocap calibrate rig --from-people (--intrinsics RIG | --hfov DEG --size WxH) VIEW1 VIEW2 "
-      "... --out RIG.toml [--height M]",
-      "Calibrates the cameras' poses from the people they film: one OpenPose JSON folder per "
-      "camera, in\nthe rig's order and in step (JSON index i of every view taken at the same "
-      "instant). Takes\nthe person in each view and frame, the relative pose of the "
-      "best-connected pair of cameras\n(essential matrix, RANSAC) and the others by PnP, then "
-      "one bundle adjustment over the camera\nposes and the joints of every frame used, the "
-      "bones' lengths held constant over the frames\n(keypoints off by more than --outlier x "
-      "the median dropped and the solve repeated). Metres\nfrom --height (default: the "
-      "canonical body's); the world from the feet: floor z = 0, z up,\norigin under the "
-      "people's mean position, x along the first camera's heading. Prints each\ncamera's RMS "
-      "reprojection error and writes the rig (docs/cameras.md). The people must move\nthrough "
-      "the space (one person standing still is refused).");
-  args.positional("views", "an OpenPose JSON folder per camera, in the rig's order", true);
+      "mocap calibrate rig --from-people (--intrinsics RIG | --hfov DEG [--size WxH]) VIEW1 VIEW2 "
+      "... --out RIG.toml [--height M] [--detector NAME] [--keypoints DIR]",
+      "Calibrates the cameras' poses from the people they film: one view per camera, in the "
+      "rig's\norder and in step (frame i of every view taken at the same instant): an OpenPose "
+      "JSON folder,\na video or an image folder. Videos and image folders go through the "
+      "detector first (--detector,\nas mocap reconstruct names them; frames per view on a "
+      "progress bar) and their detections are\nkept as OpenPose JSON, one folder per camera "
+      "under --keypoints (default: RIG's name +\n_keypoints beside --out), which a second run "
+      "takes as its views without detecting again.\nTakes the person in each view and frame, "
+      "the relative pose of the best-connected pair of\ncameras (essential matrix, RANSAC) and "
+      "the others by PnP, then one bundle adjustment over the\ncamera poses and the joints of "
+      "every frame used, the bones' lengths held constant over the\nframes (keypoints off by "
+      "more than --outlier x the median dropped and the solve repeated).\nMetres from the "
+      "person's standing height (--height; default: the canonical body's); the world\nfrom the "
+      "feet: floor z = 0, z up, origin under the people's mean position, x along the first\n"
+      "camera's heading. Prints each camera's RMS reprojection error and writes the rig\n"
+      "(docs/cameras.md). The people must move through the space (one person standing still "
+      "is\nrefused), and the cameras must stand apart (the same video twice is refused).");
+  args.positional("views",
+                  "per camera, in the rig's order: an OpenPose JSON folder, a video or an image "
+                  "folder",
+                  true);
   args.flag("from-people", "calibrate from the people in view (this command)")
       .option("intrinsics", "RIG",
               "each camera's matrix, distortion and size from this rig file, camera k for view k "
@@ -506,28 +518,51 @@ int rig_people_command(int argc, char** argv) {
               "without --intrinsics: every camera a pinhole of this horizontal field of view, "
               "without distortion",
               std::nullopt, Range::between(1.0, 179.0))
-      .option("size", "WxH", "with --hfov: the images' size in pixels", std::nullopt,
-              Range::image_size())
+      .option("size", "WxH",
+              "with --hfov: the images' size in pixels (default for videos and image folders: "
+              "their own; needed for JSON views)",
+              std::nullopt, Range::image_size())
       .option("cameras", "NAMES",
               "comma-separated camera names, one per view (default: those of --intrinsics, "
               "else cam_01, cam_02, ...)")
       .option("layout", "NAME", "the JSON's 25-keypoint layout: auto, BODY_25 or BODY_25B", "auto")
       .option("height", "M",
-              "the person's height, metres, as the 15-joint skeleton measures it: head top to sole "
-              "along the bones (default: the canonical body's, 1.52 m; docs/cameras.md)",
+              "the person's standing height, floor to top of head, metres (default: the "
+              "canonical body's, " +
+                  fixed(motion::canonical_stature_m(), 2) + " m; docs/cameras.md)",
               std::nullopt, Range::between(0.5, 2.5))
       .option("outlier", "X", "drop keypoints whose error exceeds X times the median (> 1)", "3",
               outlier_range())
       .option("min-shared", "N", "frames with a person each camera must share with another", "20",
               Range::count(1))
+      .option("detector", "NAME",
+              "videos and image folders: how people are found, one of " + detector_names(),
+              std::string(kFileDetector))
+      .option("keypoints", "DIR",
+              "videos and image folders: where their detections are kept, DIR/<camera>/ as "
+              "OpenPose JSON (default: beside --out, its name + _keypoints)")
+      .flag("force", "detect again over detections kept in --keypoints by an earlier run")
+      .option("frames", "N", "use the first N frames of every view (default: all)", std::nullopt,
+              Range::count(1))
+      .option("fps", "F", "the frame rate of image folders (default 30)", std::nullopt,
+              Range::between(0.001, 10000.0))
+      .flag("quiet", "no progress while detecting")
       .option("out", "FILE", "where to write the rig (.toml or .yml; nothing written when absent)");
   int code = 0;
   if (!args.parse(argc, argv, code)) return code;
-  const std::vector<std::string>& views = args.positionals();
-  if (views.size() < 2) throw InputError("mocap calibrate rig", "give at least 2 views");
+  const std::vector<std::string>& paths = args.positionals();
+  if (paths.size() < 2) throw InputError("mocap calibrate rig", "give at least 2 views");
   if (args.has("out")) camera::rig_format_for_writing(args.get("out"));  // a bad name fails now
   if (args.has("intrinsics") == args.has("hfov"))
     throw InputError("mocap calibrate rig --from-people", "give one of --intrinsics and --hfov");
+  PeopleViewsOptions view_options;
+  view_options.detector = args.get("detector");
+  detector_preset(view_options.detector);  // an unknown name fails now, listing the names
+  view_options.force = args.has("force");
+  view_options.quiet = args.has("quiet");
+  if (args.has("frames")) view_options.max_frames = args.integer("frames");
+  if (args.has("fps")) view_options.folder_fps = args.number("fps");
+  std::vector<PeopleView> views = open_people_views(paths, view_options);
 
   std::vector<camera::Camera> cameras;
   if (args.has("intrinsics")) {
@@ -538,12 +573,19 @@ int rig_people_command(int argc, char** argv) {
                                  std::to_string(views.size()) + " views (camera k for view k)");
     cameras.assign(rig.cameras.begin(), rig.cameras.begin() + static_cast<long>(views.size()));
   } else {
-    if (!args.has("size")) throw InputError("--hfov", "needs the images' size (--size WxH)");
-    const ImageSize size = args.image_size("size");
-    for (std::size_t i = 0; i < views.size(); ++i)
+    for (std::size_t i = 0; i < views.size(); ++i) {
+      ImageSize size{views[i].width, views[i].height};
+      if (args.has("size")) {
+        size = args.image_size("size");
+      } else if (views[i].kind == PeopleViewKind::openpose_json) {
+        throw InputError("--hfov", views[i].path +
+                                       " is an OpenPose JSON folder: give the images' size "
+                                       "(--size WxH)");
+      }
       cameras.push_back(camera::Camera::from_fov(
           size.width, size.height, args.number("hfov"),
           std::string("cam_") + (i < 9 ? "0" : "") + std::to_string(i + 1)));
+    }
   }
   if (args.has("cameras")) {
     std::stringstream list(args.get("cameras"));
@@ -554,20 +596,40 @@ int rig_people_command(int argc, char** argv) {
                                         std::to_string(views.size()) + " views");
     for (std::size_t i = 0; i < views.size(); ++i) cameras[i].name = names[i];
   }
+  check_people_views(views, cameras);
 
   const std::string layout = args.get("layout");
   if (layout != "auto" && layout != "BODY_25" && layout != "BODY_25B")
     throw InputError("--layout", "expected auto, BODY_25 or BODY_25B, got '" + layout + "'");
+  const bool detecting = std::any_of(views.begin(), views.end(), [](const PeopleView& v) {
+    return v.kind == PeopleViewKind::video;
+  });
+  if (detecting) {
+    if (args.has("keypoints")) {
+      view_options.keypoints = args.get("keypoints");
+    } else if (args.has("out")) {
+      const fs::path out = args.get("out");
+      view_options.keypoints = out.parent_path() / (out.stem().string() + "_keypoints");
+    } else {
+      throw InputError("mocap calibrate rig --from-people",
+                       "videos and image folders need --keypoints DIR or --out (their detections "
+                       "are kept beside it)");
+    }
+    detect_people(views, cameras, view_options);
+  }
+
   io::OpenPoseOptions json_options;
   json_options.body25 = layout == "auto"       ? io::Body25Choice::detect
                         : layout == "BODY_25B" ? io::Body25Choice::body25b
                                                : io::Body25Choice::body25;
   std::vector<camera::BodySequence> sequences;
-  for (const std::string& folder : views) {
-    const io::OpenPoseSequence json = io::read_openpose_folder(folder, json_options);
+  for (const PeopleView& v : views) {
+    const io::OpenPoseSequence json = io::read_openpose_folder(v.json, json_options);
     for (const io::FrameProblem& p : json.problems)
-      std::cerr << "mocap calibrate rig: " << folder << ": " << p.message << "\n";
+      std::cerr << "mocap calibrate rig: " << v.json.string() << ": " << p.message << "\n";
     sequences.push_back(camera::body_sequence(json.frames));
+    if (view_options.max_frames && sequences.back().size() > std::size_t(*view_options.max_frames))
+      sequences.back().resize(static_cast<std::size_t>(*view_options.max_frames));
   }
 
   calibration::PeopleCalibrationOptions options;
@@ -575,7 +637,7 @@ int rig_people_command(int argc, char** argv) {
   options.outlier_factor = args.number("outlier");
   options.min_shared_frames = static_cast<int>(args.integer("min-shared"));
   const calibration::PeopleCalibration result =
-      calibration::calibrate_rig_from_people(cameras, sequences, views, options);
+      calibration::calibrate_rig_from_people(cameras, sequences, paths, options);
 
   std::cout << result.frames_used << " frames in the bundle adjustment; person height "
             << fixed(result.height_m, 3) << " m; motion " << fixed(result.motion, 3)
