@@ -37,6 +37,13 @@ void Contract::add_output(PortSpec port) {
     throw std::logic_error("output '" + port.name + "' is the same as unknown input '" +
                            port.same_as + "' (declare inputs first)");
   }
+  if (port.repeated) {
+    const int input = input_index(port.per_edge_of);
+    if (input < 0 || !inputs_[static_cast<std::size_t>(input)].repeated) {
+      throw std::logic_error("repeated output '" + port.name + "' needs a repeated input, not '" +
+                             port.per_edge_of + "' (declare inputs first)");
+    }
+  }
   outputs_.push_back(std::move(port));
 }
 

@@ -19,9 +19,12 @@ struct PortSpec {
   std::string same_as;    // outputs: carries the type of this input (pass-through nodes)
   bool optional = false;  // inputs: may stay unconnected
   std::string doc;
-  // Inputs only: a repeated input takes min_count..max_count edges, wired to name:0, name:1, ...
+  // Inputs: a repeated input takes min_count..max_count edges, wired to name:0, name:1, ...
+  // Outputs: a repeated output has one stream per edge of the repeated input `per_edge_of`
+  // (name:i goes with that input's edge i), each wired to any number of edges as name:i.
   bool repeated = false;
   std::size_t min_count = 1, max_count = 1;
+  std::string per_edge_of{};
 
   bool any() const { return type.empty() && same_as.empty(); }
 };
@@ -83,6 +86,16 @@ class Contract {
   template <class T>
   void output(std::string name, std::string doc = {}) {
     add_output(PortSpec{std::move(name), std::string(T::kTypeName), {}, false, std::move(doc)});
+  }
+  // A repeated output: one stream per edge of the repeated input `input_name` (name:i goes with
+  // input edge i; a node sends on it with ctx.send(name, i, message)). For nodes that treat each
+  // of several streams alike (a limiter of camera frames).
+  template <class T>
+  void outputs(std::string name, std::string doc, std::string input_name) {
+    PortSpec port{std::move(name), std::string(T::kTypeName), {}, false, std::move(doc)};
+    port.repeated = true;
+    port.per_edge_of = std::move(input_name);
+    add_output(std::move(port));
   }
   // An output carrying whatever type the graph connects to input `input_name`.
   void output_same_as(std::string name, std::string input_name, std::string doc = {}) {

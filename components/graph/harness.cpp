@@ -4,6 +4,7 @@
 #include <atomic>
 #include <condition_variable>
 #include <mutex>
+#include <set>
 #include <stdexcept>
 #include <thread>
 #include <utility>
@@ -30,7 +31,12 @@ struct Harness::Impl final : public Context {
   std::size_t input_count(std::string_view port) const override { return inputs->count(port); }
   bool in_set() const override { return inputs->in_set(); }
   const Header* input_header() const override { return inputs->header(); }
-  void send_packet(std::string_view port, Packet packet) override;
+  using Context::send_packet;
+  void send_packet(std::string_view port, std::size_t index, Packet packet) override;
+  bool output_idle(std::string_view port, std::size_t index) const override {
+    const std::lock_guard lock(mutex);
+    return !busy_outputs.count({std::string(port), index});
+  }
   void count_drop() override { ++own_drops; }
   void report_status(std::string text) override {
     const std::lock_guard lock(mutex);
@@ -122,7 +128,8 @@ struct Harness::Impl final : public Context {
 
   mutable std::mutex mutex;  // outputs, status: the node's thread writes, the test reads
   std::condition_variable wake;
-  std::vector<std::vector<Packet>> sent;
+  std::vector<std::vector<std::vector<Packet>>> sent;  // per output port, per stream
+  std::set<std::pair<std::string, std::size_t>> busy_outputs;
   std::vector<bool> ended_outputs;
   std::string status;
   SyncStats sync_copy;
@@ -189,7 +196,7 @@ Harness::Impl::Impl(const std::string& type_name, const std::map<std::string, st
   instance = type->create();
 }
 
-void Harness::Impl::send_packet(std::string_view port, Packet packet) {
+void Harness::Impl::send_packet(std::string_view port, std::size_t stream, Packet packet) {
   const int index = type->contract.output_index(port);
   if (index < 0)
     throw std::logic_error("node '" + name + "' has no output '" + std::string(port) + "'");
@@ -200,7 +207,9 @@ void Harness::Impl::send_packet(std::string_view port, Packet packet) {
   }
   {
     const std::lock_guard lock(mutex);
-    sent[static_cast<std::size_t>(index)].push_back(std::move(packet));
+    auto& streams = sent[static_cast<std::size_t>(index)];
+    if (streams.size() <= stream) streams.resize(stream + 1);
+    streams[stream].push_back(std::move(packet));
   }
   ++out;
 }
@@ -340,14 +349,25 @@ void Harness::request_stop() {
   impl_->wake.notify_all();
 }
 
-std::vector<Packet> Harness::pull_packets(std::string_view output) {
+void Harness::set_output_idle(std::string_view output, std::size_t index, bool idle) {
+  const std::lock_guard lock(impl_->mutex);
+  if (idle) {
+    impl_->busy_outputs.erase({std::string(output), index});
+  } else {
+    impl_->busy_outputs.insert({std::string(output), index});
+  }
+}
+
+std::vector<Packet> Harness::pull_packets(std::string_view output, std::size_t stream) {
   const int index = impl_->type->contract.output_index(output);
   if (index < 0) {
     throw std::logic_error("harness: " + impl_->name + " has no output '" + std::string(output) +
                            "'");
   }
   const std::lock_guard lock(impl_->mutex);
-  return std::exchange(impl_->sent[static_cast<std::size_t>(index)], {});
+  auto& streams = impl_->sent[static_cast<std::size_t>(index)];
+  if (streams.size() <= stream) return {};
+  return std::exchange(streams[stream], {});
 }
 
 bool Harness::ended(std::string_view output) const {

@@ -80,11 +80,12 @@ class Harness {
   void request_stop();  // ctx.stop_requested() becomes true, sleep_for() wakes
 
   // --- results
-  std::vector<Packet> pull_packets(std::string_view output);  // everything sent so far, taken
+  // Everything sent so far on `output` (stream `index` of a repeated one), taken.
+  std::vector<Packet> pull_packets(std::string_view output, std::size_t index = 0);
   template <class T>
-  std::vector<std::shared_ptr<const T>> pull(std::string_view output) {
+  std::vector<std::shared_ptr<const T>> pull(std::string_view output, std::size_t index = 0) {
     std::vector<std::shared_ptr<const T>> messages;
-    for (Packet& packet : pull_packets(output)) {
+    for (Packet& packet : pull_packets(output, index)) {
       if (packet.type != T::kTypeName) {
         throw std::logic_error("harness: output '" + std::string(output) + "' sent " +
                                std::string(packet.type) + ", pulled as " +
@@ -94,6 +95,9 @@ class Harness {
     }
     return messages;
   }
+  // What ctx.output_idle() answers for that output stream (true until set): stands for the
+  // consumers downstream being busy or not.
+  void set_output_idle(std::string_view output, std::size_t index, bool idle);
   bool ended(std::string_view output) const;  // the node's end of stream was sent there
   NodeStats stats() const;                    // as in the graph's table (sync counts included)
   std::string status() const;                 // the last ctx.report_status() text

@@ -61,11 +61,13 @@ Inbox::Delivery Inbox::take(std::size_t index) {
   port.items.pop_front();
   if (!delivery.packet.is_end_of_stream()) --port.data_items;
   --depth_;
+  taken_ = true;
   return delivery;
 }
 
 std::optional<Inbox::Delivery> Inbox::pop() {
   std::unique_lock lock(mutex_);
+  taken_ = false;  // asking for the next: done with the last
   readable_.wait(lock, [&] { return closed_ || depth_ > 0; });
   if (closed_) return std::nullopt;
   Delivery delivery = take(oldest(nullptr));
@@ -77,6 +79,7 @@ std::optional<Inbox::Delivery> Inbox::pop() {
 Inbox::Waited Inbox::pop(const std::vector<bool>& readable,
                          std::optional<std::chrono::steady_clock::time_point> deadline) {
   std::unique_lock lock(mutex_);
+  taken_ = false;
   const auto ready = [&] { return closed_ || oldest(&readable) < ports_.size(); };
   if (deadline) {
     if (!readable_.wait_until(lock, *deadline, ready)) return {};
@@ -92,6 +95,7 @@ Inbox::Waited Inbox::pop(const std::vector<bool>& readable,
 
 std::optional<Inbox::Delivery> Inbox::try_pop(const std::vector<bool>& readable) {
   std::unique_lock lock(mutex_);
+  taken_ = false;
   const std::size_t port = oldest(&readable);
   if (closed_ || port == ports_.size()) return std::nullopt;
   Delivery delivery = take(port);
@@ -123,6 +127,11 @@ std::uint64_t Inbox::drops() const {
 std::size_t Inbox::depth() const {
   std::lock_guard lock(mutex_);
   return depth_;
+}
+
+bool Inbox::idle() const {
+  std::lock_guard lock(mutex_);
+  return closed_ || (depth_ == 0 && !taken_);  // a closed inbox discards: nothing to wait for
 }
 
 std::size_t Inbox::max_depth() const {

@@ -55,6 +55,9 @@ class Inbox {
 
   std::uint64_t drops() const;
   std::size_t depth() const;
+  // Nothing queued, and the node came back for more since it last took a message (it is not
+  // processing one): what Context::output_idle asks of each consumer.
+  bool idle() const;
   std::size_t max_depth() const;
   // How long the messages taken lately waited in this inbox (push to pop), {p50, p95} in
   // microseconds: a stage that cannot keep up shows here as a growing wait.
@@ -83,6 +86,7 @@ class Inbox {
   std::uint64_t drops_ = 0;
   std::size_t depth_ = 0, max_depth_ = 0;
   bool closed_ = false;
+  bool taken_ = false;  // a message was taken and the node has not asked for the next yet
   LatencyWindow wait_;
 };
 

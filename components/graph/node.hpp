@@ -86,10 +86,22 @@ class Context {
   void send(std::string_view port, std::shared_ptr<const T> message) {
     send_packet(port, Packet::of<T>(std::move(message)));
   }
+  // Stream `index` of a repeated output (Contract::outputs).
+  template <class T>
+  void send(std::string_view port, std::size_t index, T message) {
+    if (message.header == Header{}) {
+      if (const Header* inherited = input_header()) message.header = *inherited;
+    }
+    send_packet(port, index, Packet::of<T>(std::make_shared<const T>(std::move(message))));
+  }
   // Sends the current input on unchanged, without a copy (pass-through, flow control).
   void forward(std::string_view output, std::string_view input) {
     send_packet(output, current(input));
   }
+  // True when every node that output `port` (stream `index` of a repeated one) feeds in this
+  // process has nothing queued and is not processing: sending now starts work at once. A consumer
+  // in another process cannot be seen and counts as idle. For flow control (flow.set_limiter).
+  virtual bool output_idle(std::string_view port, std::size_t index = 0) const = 0;
   // Counts a message this node chose to discard (flow limiters); shown with the edge drops.
   virtual void count_drop() = 0;
   // Replaces the node's status line in the graph's statistics (GraphStats, the table printed at
@@ -111,7 +123,11 @@ class Context {
   virtual const Packet* find_input(std::string_view port, std::size_t index = 0) const = 0;
   // As find_input, but throws (a bug in the node) when the port holds no message in this call.
   const Packet& current(std::string_view port, std::size_t index = 0) const;
-  virtual void send_packet(std::string_view port, Packet packet) = 0;
+  void send_packet(std::string_view port, Packet packet) {
+    send_packet(port, 0, std::move(packet));
+  }
+  // `index`: the stream of a repeated output; 0 for a plain one.
+  virtual void send_packet(std::string_view port, std::size_t index, Packet packet) = 0;
   virtual const ParamValue& param_value(std::string_view name) const = 0;
 };
 

@@ -20,7 +20,10 @@ SyncOptions sync_options(const std::map<std::string, ParamValue>& params, AtBoun
   options.key =
       std::get<std::string>(value("sync_by")) == "frame" ? SyncKey::frame : SyncKey::capture_time;
   options.bound = static_cast<std::size_t>(std::get<std::int64_t>(value("sync_bound")));
-  options.tolerance_ns = milliseconds(value("sync_tolerance_ms"));
+  // Frame numbers match exactly: the tolerance is for capture times only (a node whose default
+  // joins by capture time keeps its tolerance when a graph sets sync_by: frame).
+  options.tolerance_ns =
+      options.key == SyncKey::capture_time ? milliseconds(value("sync_tolerance_ms")) : 0;
   options.wait = std::chrono::nanoseconds(milliseconds(value("sync_wait_ms")));
   options.at_bound = at_bound;
   return options;

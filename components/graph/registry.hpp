@@ -52,7 +52,7 @@ bool register_node(std::string_view name) {
 
 // Bumped whenever Node, Context, Contract or the message types change layout; a plugin built
 // against another version is refused instead of crashing.
-inline constexpr const char* kPluginAbi = "mocap-graph-abi-2";
+inline constexpr const char* kPluginAbi = "mocap-graph-abi-3";
 
 }  // namespace mocap::graph
 

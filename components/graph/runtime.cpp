@@ -146,14 +146,27 @@ class NodeRunner final : public Context {
         node_(node),
         contract_(node.type->contract),
         inputs_(node.type->contract, node.input_counts, std::move(policies), node.params, at_bound),
-        inbox_(inputs_.inbox()),
-        outputs_(node.type->contract.outputs().size()) {
-    for (std::size_t i = 0; i < outputs_.size(); ++i) outputs_[i].type = node.output_types[i];
+        inbox_(inputs_.inbox()) {
+    // One Output per stream: a plain output has one, a repeated one one per edge of its input.
+    const auto& ports = contract_.outputs();
+    for (std::size_t i = 0; i < ports.size(); ++i) {
+      first_output_.push_back(outputs_.size());
+      const std::size_t streams = ports[i].repeated
+                                      ? node.input_counts[static_cast<std::size_t>(
+                                            contract_.input_index(ports[i].per_edge_of))]
+                                      : 1;
+      for (std::size_t k = 0; k < streams; ++k) outputs_.emplace_back().type = node.output_types[i];
+    }
+    first_output_.push_back(outputs_.size());
     instance_ = node.type->create();
   }
 
   Inbox& inbox() { return inbox_; }
-  Output& output(std::size_t i) { return outputs_[i]; }
+  // Stream `index` of output port `port` (contract order), or null when it has no such stream.
+  Output* output(std::size_t port, std::size_t index) {
+    const std::size_t slot = first_output_[port] + index;
+    return slot < first_output_[port + 1] ? &outputs_[slot] : nullptr;
+  }
   const ResolvedNode& resolved() const { return node_; }
   void set_blocks_auxiliary(bool blocks) { blocks_auxiliary_ = blocks; }
 
@@ -218,7 +231,9 @@ class NodeRunner final : public Context {
   std::size_t input_count(std::string_view port) const override { return inputs_.count(port); }
   bool in_set() const override { return inputs_.in_set(); }
   const Header* input_header() const override { return inputs_.header(); }
-  void send_packet(std::string_view port, Packet packet) override;
+  using Context::send_packet;
+  void send_packet(std::string_view port, std::size_t index, Packet packet) override;
+  bool output_idle(std::string_view port, std::size_t index) const override;
   void count_drop() override { ++own_drops_; }
   void report_status(std::string text) override {
     const std::lock_guard lock(status_mutex_);  // snapshots are taken on other threads
@@ -277,6 +292,7 @@ class NodeRunner final : public Context {
   NodeInputs inputs_;
   Inbox& inbox_;
   std::vector<Output> outputs_;
+  std::vector<std::size_t> first_output_;  // per output port: its first stream; then the total
   bool blocks_auxiliary_ = false;
   std::thread thread_;
 
@@ -295,12 +311,14 @@ class NodeRunner final : public Context {
   std::string status_;
 };
 
-void NodeRunner::send_packet(std::string_view port, Packet packet) {
+void NodeRunner::send_packet(std::string_view port, std::size_t stream, Packet packet) {
   const int index = contract_.output_index(port);
-  if (index < 0) {
-    throw std::logic_error("node '" + node_.name + "' has no output '" + std::string(port) + "'");
+  Output* found = index < 0 ? nullptr : output(static_cast<std::size_t>(index), stream);
+  if (!found) {
+    throw std::logic_error("node '" + node_.name + "' has no output '" +
+                           indexed_port(port, static_cast<long>(stream)) + "'");
   }
-  Output& out = outputs_[static_cast<std::size_t>(index)];
+  Output& out = *found;
   if (!out.type.empty() && packet.type != out.type) {
     throw std::logic_error("node '" + node_.name + "': output '" + std::string(port) +
                            "' carries " + out.type + ", not " + std::string(packet.type));
@@ -321,6 +339,19 @@ void NodeRunner::send_packet(std::string_view port, Packet packet) {
     out.sent_any = true;
   }
   ++out_;
+}
+
+bool NodeRunner::output_idle(std::string_view port, std::size_t stream) const {
+  const int index = contract_.output_index(port);
+  const std::size_t slot =
+      index < 0 ? outputs_.size() : first_output_[static_cast<std::size_t>(index)] + stream;
+  if (index < 0 || slot >= first_output_[static_cast<std::size_t>(index) + 1]) {
+    throw std::logic_error("node '" + node_.name + "' has no output '" +
+                           indexed_port(port, static_cast<long>(stream)) + "'");
+  }
+  const Output& out = outputs_[slot];
+  return std::all_of(out.local.begin(), out.local.end(),
+                     [](const auto& consumer) { return consumer.first->idle(); });
 }
 
 void NodeRunner::timed_process() {
@@ -506,8 +537,9 @@ void Runtime::Impl::add_sending_half(const EdgeSpec& edge) {
   NodeRunner* from = runner(edge.from.node);
   NodeRunner* to = runner(edge.to.node);
   if (!from) return;
-  NodeRunner::Output& out = from->output(
-      static_cast<std::size_t>(from->resolved().type->contract.output_index(edge.from.port)));
+  NodeRunner::Output& out = *from->output(
+      static_cast<std::size_t>(from->resolved().type->contract.output_index(edge.from.port)),
+      static_cast<std::size_t>(std::max(edge.from.index, 0)));  // checked by validation
   if (uses_transport(edge)) {
     out.remote.push_back({std::make_unique<Sender>(transport, edge.transport, Sender::Pattern::edge,
                                                    socket_options(edge, false)),

@@ -167,9 +167,18 @@ class Checker {
       const int out = port_index(edge, edge.from, true);
       const int in = port_index(edge, edge.to, false);
       if (out < 0 || in < 0) continue;
-      if (edge.from.index >= 0) {
+      const ResolvedNode& from = nodes_[static_cast<std::size_t>(node_index(edge.from.node))];
+      const PortSpec& out_port = from.type->contract.outputs()[static_cast<std::size_t>(out)];
+      if (!out_port.repeated && edge.from.index >= 0) {
         error(edge.where, "edge " + edge.str() + ": an output takes no index (" + edge.from.node +
                               "." + edge.from.port + ")");
+        continue;
+      }
+      if (out_port.repeated && edge.from.index < 0) {
+        error(edge.where, "edge " + edge.str() + ": " + edge.from.str() +
+                              " is a repeated output (one stream per edge of input " +
+                              out_port.per_edge_of + "): name the stream, " + edge.from.str() +
+                              ":0, " + edge.from.str() + ":1, ...");
         continue;
       }
       ResolvedNode& to = nodes_[static_cast<std::size_t>(node_index(edge.to.node))];
@@ -194,6 +203,37 @@ class Checker {
       valid_edges_.push_back(&edge);
     }
     check_repeated_inputs();
+    check_repeated_outputs();
+  }
+
+  // Stream i of a repeated output goes with edge i of its input: there are as many as that
+  // input has edges.
+  void check_repeated_outputs() {
+    for (const EdgeSpec* edge : valid_edges_) {
+      const ResolvedNode& from = nodes_[static_cast<std::size_t>(node_index(edge->from.node))];
+      const Contract& c = from.type->contract;
+      const PortSpec& port = c.outputs()[static_cast<std::size_t>(c.output_index(edge->from.port))];
+      if (!port.repeated) continue;
+      const std::size_t streams =
+          from.input_counts[static_cast<std::size_t>(c.input_index(port.per_edge_of))];
+      if (static_cast<std::size_t>(edge->from.index) < streams) continue;
+      const std::string input = from.name + "." + port.per_edge_of;
+      error(edge->where,
+            "edge " + edge->str() + ": " + edge->from.str() + " has no stream: " + from.name + "." +
+                port.name + " has one per edge of " + input + " (" + std::to_string(streams) +
+                ": " +
+                (streams ? from.name + "." + port.name + ":0.." + std::to_string(streams - 1)
+                         : std::string("none")) +
+                ")");
+    }
+    std::erase_if(valid_edges_, [&](const EdgeSpec* edge) {
+      const ResolvedNode& from = nodes_[static_cast<std::size_t>(node_index(edge->from.node))];
+      const Contract& c = from.type->contract;
+      const PortSpec& port = c.outputs()[static_cast<std::size_t>(c.output_index(edge->from.port))];
+      return port.repeated &&
+             static_cast<std::size_t>(edge->from.index) >=
+                 from.input_counts[static_cast<std::size_t>(c.input_index(port.per_edge_of))];
+    });
   }
 
   // A repeated input's edges are numbered 0..N-1 without gaps, with N within its bounds.
@@ -587,8 +627,8 @@ std::string to_dot(const ResolvedGraph& graph) {
     const ResolvedNode* from = graph.find(e.from.node);
     const auto port = static_cast<std::size_t>(from->type->contract.output_index(e.from.port));
     const std::string to_port = indexed_port(e.to.port, e.to.index);
-    out << "  \"" << e.from.node << "\" -> \"" << e.to.node << "\" [label=\"" << e.from.port
-        << " -> " << to_port << "\\n"
+    out << "  \"" << e.from.node << "\" -> \"" << e.to.node << "\" [label=\""
+        << indexed_port(e.from.port, e.from.index) << " -> " << to_port << "\\n"
         << from->output_types[port] << ", " << e.policy.str()
         << (e.transport.empty() ? "" : "\\n" + e.transport) << "\""
         << (e.policy.lossy() ? ", style=dashed" : "") << "];\n";
@@ -629,7 +669,9 @@ std::string describe(const NodeType& type) {
   out << "\n  outputs:\n";
   if (c.outputs().empty()) out << "    (none: a sink)\n";
   for (const auto& p : c.outputs()) {
-    out << "    " << p.name << " : " << port_type(p) << (p.doc.empty() ? "" : "  " + p.doc) << "\n";
+    out << "    " << p.name << (p.repeated ? ":0..N" : "") << " : " << port_type(p)
+        << (p.repeated ? " (one per edge of " + p.per_edge_of + ")" : "")
+        << (p.doc.empty() ? "" : "  " + p.doc) << "\n";
   }
   out << "\n  parameters:\n";
   if (c.params().empty()) out << "    (none)\n";

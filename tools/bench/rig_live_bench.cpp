@@ -4,8 +4,12 @@
 // multi-view graph uses), for --seconds. One camera is killed at a third of the run and started
 // again at half: the others must go on (their sets partial while it is away) and it must come
 // back. Prints one Markdown row per sample: sets, complete, missing per camera, skew p50/p95
-// (over the last 1024 sets) and max, drops, resident memory; then the verdict. No detector: the
-// fake frames have no people. A benchmark, not a test: it takes minutes.
+// (over the last 1024 sets) and max, the sets' age when joined (capture to join, p50/p95), drops,
+// resident memory; then the verdict. No detector by default (the fake frames have no people);
+// --detector-ms D puts a stage of D ms per frame behind each camera (test.delay, a detector
+// slower than the cameras), fed as the live graphs feed detectors (a `latest` edge per camera),
+// or with --limit through flow.set_limiter (whole sets while every stage is idle, joined after
+// by the limiter's set numbers). A benchmark, not a test: it takes minutes.
 
 #include <algorithm>
 #include <chrono>
@@ -42,7 +46,13 @@ struct Settings {
   int cameras = 4;
   double fps = 30, tolerance_ms = 10, wait_ms = 200;
   int width = 320, height = 240;
+  double detector_ms = 0;  // a slow stage per camera; 0: none
+  bool limit = false;      // the slow stages fed through flow.set_limiter
 };
+
+// The join after slow stages fed by the limiter: by its set numbers, waiting for a stage's output
+// (or a camera the limiter had no frame of) up to a second.
+constexpr double kJoinAfterLimiterWaitMs = 1000;
 
 std::string graph_text(const Settings& s, const std::vector<std::string>& serials) {
   std::string text = "graph: rig_live_bench\nnodes:\n";
@@ -54,13 +64,38 @@ std::string graph_text(const Settings& s, const std::vector<std::string>& serial
                   i + 1, serials[i].c_str(), s.fps, s.width, s.height, i + 1);
     text += line;
   }
-  std::snprintf(line, sizeof line,
-                "  sets: { type: sink.sets, params: { sync_by: capture_time, sync_tolerance_ms: "
-                "%g, sync_wait_ms: %g } }\nedges:\n",
-                s.tolerance_ms, s.wait_ms);
+  for (std::size_t i = 0; s.detector_ms > 0 && i < serials.size(); ++i) {
+    std::snprintf(line, sizeof line, "  det%zu: { type: test.delay, params: { delay_ms: %g } }\n",
+                  i + 1, s.detector_ms);
+    text += line;
+  }
+  if (s.limit) {
+    std::snprintf(line, sizeof line,
+                  "  limit: { type: flow.set_limiter, params: { sync_tolerance_ms: %g, "
+                  "sync_wait_ms: %g } }\n"
+                  "  sets: { type: sink.sets, params: { sync_by: frame, sync_wait_ms: %g } }\n",
+                  s.tolerance_ms, s.wait_ms, kJoinAfterLimiterWaitMs);
+  } else {
+    std::snprintf(line, sizeof line,
+                  "  sets: { type: sink.sets, params: { sync_by: capture_time, "
+                  "sync_tolerance_ms: %g, sync_wait_ms: %g } }\n",
+                  s.tolerance_ms, s.wait_ms);
+  }
   text += line;
+  text += "edges:\n";
   for (std::size_t i = 0; i < serials.size(); ++i) {
-    text += "  - [cam" + std::to_string(i + 1) + ".frames, sets.in:" + std::to_string(i) + "]\n";
+    const std::string n = std::to_string(i + 1), k = std::to_string(i);
+    std::string frames = "cam" + n + ".frames";
+    if (s.limit) {
+      text += "  - [" + frames + ", limit.frames:" + k + "]\n";
+      frames = "limit.frames:" + k;
+    }
+    if (s.detector_ms > 0) {
+      text +=
+          "  - [" + frames + ", det" + n + ".in" + (s.limit ? "]\n" : ", { policy: latest }]\n");
+      frames = "det" + n + ".out";
+    }
+    text += "  - [" + frames + ", sets.in:" + k + "]\n";
   }
   return text;
 }
@@ -72,6 +107,8 @@ struct Sample {
   std::uint64_t drops = 0;
   double rss = 0;
   std::string last_status;
+  std::string age;      // sink.sets' status: the sets' age when joined
+  std::string limiter;  // flow.set_limiter's status
 };
 
 // `watched`: the node whose status line is kept (the camera killed and restarted).
@@ -83,7 +120,11 @@ Sample sample(const graph::Runtime& runtime, double t, std::string event,
   s.rss = rss_mib();
   for (const graph::NodeStats& n : runtime.stats().nodes) {
     s.drops += n.drops;
-    if (n.node == "sets") s.sync = n.sync;
+    if (n.node == "sets") {
+      s.sync = n.sync;
+      s.age = n.status;
+    }
+    if (n.node == "limit") s.limiter = n.status;
     if (n.node == watched) s.last_status = n.status;
   }
   return s;
@@ -92,9 +133,10 @@ Sample sample(const graph::Runtime& runtime, double t, std::string event,
 void print_header(int cameras) {
   std::cout << "| t s | event | sets | complete |";
   for (int i = 1; i <= cameras; ++i) std::cout << " cam" << i << " missing |";
-  std::cout << " skew p50 ms | skew p95 ms | skew max ms | drops | RSS MiB |\n|---|---|---|---|";
+  std::cout << " skew p50 ms | skew p95 ms | skew max ms | age when joined | drops | RSS MiB "
+               "|\n|---|---|---|---|";
   for (int i = 0; i < cameras; ++i) std::cout << "---|";
-  std::cout << "---|---|---|---|---|\n";
+  std::cout << "---|---|---|---|---|---|\n";
 }
 
 void print_row(const Sample& s) {
@@ -103,8 +145,9 @@ void print_row(const Sample& s) {
               static_cast<unsigned long long>(s.sync.complete));
   for (const auto& input : s.sync.inputs)
     std::printf(" %llu |", static_cast<unsigned long long>(input.missing));
-  std::printf(" %.2f | %.2f | %.2f | %llu | %.1f |\n", s.sync.skew_p50_ms, s.sync.skew_p95_ms,
-              s.sync.skew_max_ms, static_cast<unsigned long long>(s.drops), s.rss);
+  const std::string age = s.age.rfind("age when joined ", 0) == 0 ? s.age.substr(16) : s.age;
+  std::printf(" %.2f | %.2f | %.2f | %s | %llu | %.1f |\n", s.sync.skew_p50_ms, s.sync.skew_p95_ms,
+              s.sync.skew_max_ms, age.c_str(), static_cast<unsigned long long>(s.drops), s.rss);
   std::fflush(stdout);
 }
 
@@ -120,7 +163,13 @@ int main(int argc, char** argv) {
       .option("fps", "F", "frame rate of every camera", "30", cli::Range::between(1, 120))
       .option("tolerance-ms", "MS", "sync_tolerance_ms", "10", cli::Range::positive())
       .option("wait-ms", "MS", "sync_wait_ms", "200", cli::Range::positive())
-      .option("size", "WxH", "frame size", "320x240", cli::Range::image_size());
+      .option("size", "WxH", "frame size", "320x240", cli::Range::image_size())
+      .option("detector-ms", "MS",
+              "a stage of MS per frame behind each camera (test.delay; 0: none)", "0",
+              cli::Range::between(0, 10000))
+      .flag("limit",
+            "feed the stages through flow.set_limiter (whole sets) instead of a "
+            "latest edge each");
   int code = 0;
   if (!args.parse(argc - 1, argv + 1, code)) return code;
   if (!loopback.empty()) {
@@ -140,6 +189,8 @@ int main(int argc, char** argv) {
   s.wait_ms = args.number("wait-ms");
   s.width = args.image_size("size").width;
   s.height = args.image_size("size").height;
+  s.detector_ms = args.number("detector-ms");
+  s.limit = args.has("limit");
   const double seconds = args.number("seconds");
 
   std::vector<std::string> serials;
@@ -157,11 +208,15 @@ int main(int argc, char** argv) {
   std::thread run([&] { result = runtime.run(); });
   const auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - start).count(); };
 
+  char stage[96] = "no detector";
+  if (s.detector_ms > 0)
+    std::snprintf(stage, sizeof stage, "a %g ms stage per camera %s", s.detector_ms,
+                  s.limit ? "behind flow.set_limiter" : "on a latest edge");
   std::printf(
       "%d fake cameras at %g fps (%dx%d Mono8), sync_tolerance_ms %g, sync_wait_ms %g, "
-      "%g s; cam%d killed at %.0f s, restarted at %.0f s\n\n",
+      "%g s; cam%d killed at %.0f s, restarted at %.0f s; %s\n\n",
       s.cameras, s.fps, s.width, s.height, s.tolerance_ms, s.wait_ms, seconds, s.cameras,
-      seconds / 3, seconds / 2);
+      seconds / 3, seconds / 2, stage);
   print_header(s.cameras);
   std::vector<Sample> samples;
   const std::string watched = "cam" + std::to_string(s.cameras);
@@ -250,5 +305,7 @@ int main(int argc, char** argv) {
               static_cast<unsigned long long>(end.sync.restarts),
               result.ok ? "ok" : result.error.c_str());
   std::cout << graph::format_sync_stats(end.sync) << "\n";
+  std::printf("sets' %s\n", end.age.c_str());
+  if (s.limit) std::printf("limiter: %s\n", end.limiter.c_str());
   return result.ok ? 0 : 1;
 }

@@ -1,12 +1,15 @@
 // `mocap reconstruct --calibration RIG VIEW1 VIEW2 ... --out DIR`: several calibrated views of one
-// scene (each a folder of OpenPose JSON, a video file or an image folder, in the rig's camera
-// order) to the people in the rig's world: poses.jsonl with each person's joints_world, one BVH
-// per person (y up, the floor at y = 0) and summary.json. Builds the graph of
-// graphs/multiview_json.yaml (or its video form) for the number of views, after checking what can
-// be checked before DIR is touched: the rig, one view per camera, the views' image sizes against
-// the rig's.
+// scene (each a folder of OpenPose JSON, a video file, an image folder or a live camera, in the
+// rig's camera order) to the people in the rig's world: poses.jsonl with each person's
+// joints_world, one BVH per person (y up, the floor at y = 0) and summary.json. Builds the graph of
+// graphs/multiview_json.yaml (or its video or live form) for the number of views, after checking
+// what can be checked before DIR is touched: the rig, one view per camera, the views' image sizes
+// against the rig's, files and cameras not mixed.
 
+#include <pthread.h>
 #include <unistd.h>
+
+#include <csignal>
 
 #include <algorithm>
 #include <chrono>
@@ -18,6 +21,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "camera.hpp"
 #include "camera/rig_file.hpp"
 #include "cli_args.hpp"
 #include "core/input_error.hpp"
@@ -42,11 +46,18 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-enum class ViewKind { openpose_json, video };
+// Files are joined by frame number; cameras (V4L2 devices, streams, GigE/USB3 Vision) are live and
+// joined by capture time.
+enum class ViewKind { openpose_json, video, camera };
+
+// A GigE Vision / USB3 Vision camera as a view: aravis:ID, the ID being what `mocap camera list`
+// shows (device id, serial or address) and what source.aravis's `id` takes.
+constexpr std::string_view kAravisPrefix = "aravis:";
 
 struct View {
   std::string path;
   ViewKind kind = ViewKind::openpose_json;
+  bool aravis = false;  // kind camera: through source.aravis (else source.video, live)
   const camera::Camera* camera = nullptr;
   std::int64_t frames = -1;
   double fps = 0.0;                             // videos: their own rate
@@ -55,6 +66,10 @@ struct View {
 };
 
 ViewKind view_kind(const std::string& path) {
+  if (path.starts_with(kAravisPrefix)) return ViewKind::camera;
+  const video::SourceKind source = video::classify(path);
+  if (source == video::SourceKind::device || source == video::SourceKind::network)
+    return ViewKind::camera;
   std::error_code ec;
   if (fs::is_directory(path, ec)) {
     bool images = false;
@@ -119,13 +134,77 @@ void check_video_view(View& view, const std::string& rig_file, const Args& args)
   view.fps = source.fps();
 }
 
+std::string size_mismatch(const View& view, int width, int height, const std::string& rig_file,
+                          const std::string& what_to_do) {
+  const camera::Camera& c = *view.camera;
+  return view.path + " delivers " + size_text(width, height) + " but camera '" + c.name + "' of " +
+         rig_file + " is " + size_text(c.width, c.height) + ": " + what_to_do;
+}
+
+// A camera is opened once to read the size it delivers (then closed: the graph opens it again).
+// A V4L2 device is asked for its camera's calibrated size and --fps; a GigE camera keeps its own
+// region (cropping it would move the principal point): it must already be at the calibrated size.
+void check_camera_view(View& view, const std::string& rig_file, const Args& args) {
+  const camera::Camera& c = *view.camera;
+  if (view.aravis) {
+    aravis::CameraSettings settings;
+    settings.id = view.path.substr(kAravisPrefix.size());
+    if (args.has("fps")) settings.frame_rate = args.number("fps");
+    aravis::Region region;
+    try {
+      const aravis::Camera probe(settings);
+      region = probe.region();
+      view.fps = probe.frame_rate();
+    } catch (const std::exception& e) {
+      throw InputError(c.name, "cannot open " + view.path + " (" + e.what() +
+                                   "); `mocap camera list` shows the cameras Aravis sees");
+    }
+    if (region.width != c.width || region.height != c.height)
+      throw InputError(c.name, size_mismatch(view, region.width, region.height, rig_file,
+                                             "set the camera's region to the calibrated size "
+                                             "(or calibrate at the size it delivers)"));
+    return;
+  }
+  video::SourceOptions options;
+  options.width = c.width;
+  options.height = c.height;
+  if (args.has("fps")) options.fps = args.number("fps");
+  std::optional<video::VideoSource> opened;
+  try {
+    opened.emplace(view.path, options);
+  } catch (const std::exception& e) {
+    throw InputError(c.name, e.what());  // names the device or stream, and what to do
+  }
+  const video::VideoSource& source = *opened;
+  if (source.width() != c.width || source.height() != c.height)
+    throw InputError(c.name, size_mismatch(view, source.width(), source.height(), rig_file,
+                                           "give the views in the rig's camera order, each a "
+                                           "camera that delivers its calibrated size"));
+  view.fps = source.fps();
+}
+
+// Files are joined by frame number, cameras by capture time: one run takes one or the other.
+void refuse_mixed_views(const std::vector<View>& views) {
+  const auto camera = std::find_if(views.begin(), views.end(),
+                                   [](const View& v) { return v.kind == ViewKind::camera; });
+  const auto file = std::find_if(views.begin(), views.end(),
+                                 [](const View& v) { return v.kind != ViewKind::camera; });
+  if (camera == views.end() || file == views.end()) return;
+  throw InputError(camera->camera->name,
+                   camera->path + " is a live camera but " + file->path + " (camera '" +
+                       file->camera->name +
+                       "') is a file: files are joined frame by frame, cameras by the time "
+                       "they took their frames, so one run takes either files or cameras; "
+                       "record the cameras to files first, or give a camera for every view");
+}
+
 // The views are joined frame by frame: videos at different rates would drift apart (29.97 against
 // 30 fps: a frame every 33 s), so they are refused, naming both (not resampled: which frames to
 // drop or repeat is the user's choice, and a tool like ffmpeg -r does it once).
 void check_frame_rates(const std::vector<View>& views) {
   const View* first = nullptr;
   for (const View& v : views) {
-    if (v.kind == ViewKind::openpose_json || v.fps <= 0.0) continue;  // no rate of its own
+    if (v.kind != ViewKind::video || v.fps <= 0.0) continue;  // no rate of its own, or live
     if (!first) {
       first = &v;
     } else if (std::abs(v.fps - first->fps) > 1e-3 * first->fps) {
@@ -162,6 +241,7 @@ std::vector<View> match_views(const camera::Rig& rig, const std::vector<std::str
     View& v = views.emplace_back();
     v.path = paths[i];
     v.kind = view_kind(paths[i]);
+    v.aravis = paths[i].starts_with(kAravisPrefix);
     v.camera = &rig.cameras[i];
   }
   return views;
@@ -169,48 +249,108 @@ std::vector<View> match_views(const camera::Rig& rig, const std::vector<std::str
 
 std::string quoted(const std::string& text) { return json(text).dump(); }
 
-// The graph of graphs/multiview_json.yaml (and its video form) for these views.
+void block_stop_signals() {
+  sigset_t stop;
+  sigemptyset(&stop);
+  sigaddset(&stop, SIGINT);
+  sigaddset(&stop, SIGTERM);
+  pthread_sigmask(SIG_BLOCK, &stop, nullptr);
+}
+
+// Live: a set the cameras' frames could not complete goes on after this wait (a stalled or lost
+// camera holds the others back no longer; source.aravis reopens a lost one by itself).
+constexpr int kLiveSyncWaitMs = 200;
+// Live: how long the solve waits for a view of a set that the limiter passed without it (its
+// camera stalled): longer than one detection takes under load, so that a complete set never goes
+// on partial because one detector finished late.
+constexpr int kLiveSolveWaitMs = 1000;
+
+void write_detector(std::ostringstream& g, std::size_t i, const std::string& detector) {
+  const DetectorPreset& preset = detector_preset(detector);
+  g << "  detect_" << i << ": { type: " << preset.type << ", params: {";
+  for (std::size_t p = 0; p < preset.params.size(); ++p)
+    g << (p ? ", " : " ") << preset.params[p].first << ": " << quoted(preset.params[p].second);
+  g << " } }\n";
+}
+
+// A live camera's source node: GigE/USB3 Vision through Aravis, anything else (a V4L2 device, a
+// stream) through source.video in live mode, a device asked for its camera's calibrated size.
+void write_camera_source(std::ostringstream& g, std::size_t i, const View& v, const Args& args) {
+  const std::string camera = quoted(v.camera->name);
+  const std::string fps = args.has("fps") ? ", fps: " + args.get("fps") : "";
+  if (v.aravis) {
+    g << "  view_" << i
+      << ": { type: source.aravis, params: { id: " << quoted(v.path.substr(kAravisPrefix.size()))
+      << fps << ", camera: " << camera << " } }\n";
+    return;
+  }
+  g << "  view_" << i << ": { type: source.video, params: { path: " << quoted(v.path)
+    << ", mode: live, width: " << v.camera->width << ", height: " << v.camera->height << fps
+    << ", camera: " << camera << " } }\n";
+}
+
+// Live cameras' frames are joined by capture time first (flow.set_limiter): a set goes to every
+// camera's detector at once, and only while all of them are idle, so each detector works on the
+// same instants and the people join complete even when detection is slower than the cameras. The
+// limiter numbers the sets; the solve joins by that number, and waits for a view the limiter had
+// no frame for (a stalled camera) at most its sync_wait_ms.
+std::string live_graph_part(const std::vector<View>& views, double fps, const std::string& detector,
+                            const Args& args, std::ostringstream& edges) {
+  std::ostringstream g;
+  for (std::size_t i = 0; i < views.size(); ++i) {
+    write_camera_source(g, i, views[i], args);
+    write_detector(g, i, detector);
+    edges << "  - [view_" << i << ".frames, limit.frames:" << i << "]\n"
+          << "  - [limit.frames:" << i << ", detect_" << i << ".in]\n"
+          << "  - [detect_" << i << ".out, solve.view:" << i << "]\n";
+  }
+  // Under half a frame period, or two frames of one camera could fall into one set.
+  const double tolerance_ms = 0.4 * 1000.0 / fps;
+  g << "  limit: { type: flow.set_limiter, params: { sync_tolerance_ms: "
+    << json(tolerance_ms).dump() << ", sync_wait_ms: " << kLiveSyncWaitMs << " } }\n";
+  return g.str();
+}
+
+// The graph of graphs/multiview_json.yaml (and its video and live forms) for these views.
 std::string graph_text(const std::vector<View>& views, const std::string& rig_file,
                        const fs::path& out, double fps, const std::string& detector,
-                       const std::string& trc_world_up, const std::string& fit) {
+                       const std::string& trc_world_up, const std::string& fit, const Args& args) {
   const std::string rate = json(fps).dump();
-  std::ostringstream g;
+  const bool live = views.front().kind == ViewKind::camera;  // not mixed (refuse_mixed_views)
+  std::ostringstream g, edges;
   g << "graph: multiview_reconstruct\nnodes:\n";
-  for (std::size_t i = 0; i < views.size(); ++i) {
+  if (live) g << live_graph_part(views, fps, detector, args, edges);
+  for (std::size_t i = 0; !live && i < views.size(); ++i) {
     const View& v = views[i];
     const std::string camera = quoted(v.camera->name);
     if (v.kind == ViewKind::openpose_json) {
       g << "  view_" << i << ": { type: source.openpose_json, params: { path: " << quoted(v.path)
         << ", fps: " << rate << ", camera: " << camera << ", frame_offset: " << v.frame_offset
         << " } }\n";
+      edges << "  - [view_" << i << ".out, solve.view:" << i << "]\n";
       continue;
     }
     g << "  view_" << i << ": { type: source.video, params: { path: " << quoted(v.path)
       << ", mode: offline, fps: " << rate << ", camera: " << camera
       << ", frame_offset: " << v.frame_offset << " } }\n";
-    const DetectorPreset& preset = detector_preset(detector);
-    g << "  detect_" << i << ": { type: " << preset.type << ", params: {";
-    for (std::size_t p = 0; p < preset.params.size(); ++p)
-      g << (p ? ", " : " ") << preset.params[p].first << ": " << quoted(preset.params[p].second);
-    g << " } }\n";
+    write_detector(g, i, detector);
+    edges << "  - [view_" << i << ".frames, detect_" << i << ".in]\n"
+          << "  - [detect_" << i << ".out, solve.view:" << i << "]\n";
   }
   g << "  solve: { type: multiview.reconstruct, params: { rig: " << quoted(rig_file)
-    << ", fps: " << rate << ", fit: " << fit << " } }\n"
+    << ", fps: " << rate << ", fit: " << fit;
+  // Live: the limiter's set numbers are the frames; a set the limiter passed without a view waits
+  // for it this long (longer than a detection takes, or complete sets would go on partial).
+  if (live) g << ", sync_by: frame, sync_wait_ms: " << kLiveSolveWaitMs;
+  g << " } }\n"
     << "  jsonl: { type: sink.jsonl, params: { path: " << quoted((out / "poses.jsonl").string())
     << " } }\n"
     << "  bvh: { type: sink.bvh_joints, params: { dir: " << quoted(out.string())
     << ", fps: " << rate << " } }\n"
     << "  trc: { type: sink.trc, params: { path: " << quoted((out / "person_{id}.trc").string())
-    << ", fps: " << rate << ", world_up: " << trc_world_up << " } }\nedges:\n";
-  for (std::size_t i = 0; i < views.size(); ++i) {
-    if (views[i].kind == ViewKind::openpose_json) {
-      g << "  - [view_" << i << ".out, solve.view:" << i << "]\n";
-    } else {
-      g << "  - [view_" << i << ".frames, detect_" << i << ".in]\n"
-        << "  - [detect_" << i << ".out, solve.view:" << i << "]\n";
-    }
-  }
-  g << "  - [solve.out, jsonl.in]\n  - [solve.out, bvh.in]\n  - [solve.out, trc.in]\n";
+    << ", fps: " << rate << ", world_up: " << trc_world_up << " } }\nedges:\n"
+    << edges.str()
+    << "  - [solve.out, jsonl.in]\n  - [solve.out, bvh.in]\n  - [solve.out, trc.in]\n";
   return g.str();
 }
 
@@ -262,6 +402,18 @@ void apply_offsets(std::vector<View>& views, const camera::Rig& rig, const Args&
   for (View& v : views) v.frame_offset -= earliest;
 }
 
+std::string kind_name(const View& v) {
+  switch (v.kind) {
+    case ViewKind::openpose_json:
+      return "openpose_json";
+    case ViewKind::video:
+      return "video";
+    case ViewKind::camera:
+      return "camera";
+  }
+  return "?";
+}
+
 json offsets_json(const View& v) {
   json o = {{"applied_frames", v.frame_offset}};
   if (v.estimated) {
@@ -286,10 +438,13 @@ int reconstruct_multiview_command(int argc, char** argv) {
       "mocap reconstruct --calibration RIG VIEW1 VIEW2 ... --out DIR [--fps F] [--force]",
       "Reconstructs every person seen by several calibrated cameras, in the rig's world. Each\n"
       "VIEW is a folder of OpenPose JSON, a video file or a folder of images (people found by the\n"
-      "detector), one per camera of RIG, in the rig's order. Writes into DIR: poses.jsonl (one "
-      "line\n"
-      "per frame set: per person the track id and the 15 joints, metres, under joints_world in\n"
-      "the rig's world), person_<id>.bvh per person (a humanoid skeleton with the person's bone\n"
+      "detector), one per camera of RIG, in the rig's order; or, live, every VIEW a camera: a\n"
+      "V4L2 device (/dev/videoN), a stream URL (rtsp://...) or a GigE/USB3 Vision camera\n"
+      "(aravis:ID, ID as `mocap camera list` shows it: device id, serial or address), joined by\n"
+      "the time they took their frames, until Ctrl-C (files and cameras are not mixed).\n"
+      "Writes into DIR: poses.jsonl (one line per frame set: per person the track id and the 15\n"
+      "joints, metres, under joints_world in the rig's world), person_<id>.bvh per person (a "
+      "humanoid skeleton with the person's bone\n"
       "lengths, y up, the floor at y = 0: the rig's floor, else the plane through its origin\n"
       "across the cameras' up axis, e.g. z = 0 for Pose2Sim), person_<id>.trc per person (the 15\n"
       "joints as markers, Y up as Pose2Sim writes them, for OpenSim) and summary.json. People seen "
@@ -297,19 +452,23 @@ int reconstruct_multiview_command(int argc, char** argv) {
       "camera only are dropped and counted. A view's unreadable frames are named and the others\n"
       "go on; views of different lengths go on with the views left (counted as missing).\n"
       "DIR holding an earlier run's output is refused unless --force (as without --calibration).");
-  args.positional("VIEW", "one per rig camera: OpenPose JSON folder, video file or image folder",
+  args.positional("VIEW",
+                  "one per rig camera: OpenPose JSON folder, video file or image folder; or a "
+                  "camera: /dev/videoN, rtsp:// URL, aravis:ID",
                   true)
       .option("calibration", "RIG",
               "the rig: Pose2Sim/anipose TOML or OpenCV YAML (docs/cameras.md)")
       .option("out", "DIR", "output folder (created)")
       .flag("force", "replace an earlier run's output in DIR")
       .option("fps", "N",
-              "frame rate of OpenPose JSON and image folders (30 when absent); videos have their "
-              "own",
+              "frame rate of OpenPose JSON and image folders (30 when absent), and the rate asked "
+              "of cameras; videos and streams have their own",
               std::nullopt, Range::between(0.1, 1000.0))
       .option("detector", "NAME",
-              "videos and image folders: how people are found, one of " + detector_names(),
-              std::string(kFileDetector))
+              "videos, image folders and cameras: how people are found: auto (" +
+                  std::string(kFileDetector) + " for files, " + std::string(kLiveDetector) +
+                  " for cameras, as without --calibration) or one of " + detector_names(),
+              "auto")
       .option("fit", "auto|off|live|full",
               "skeleton fit on all views (constant bone lengths per person, smooth, feet above "
               "the floor): full in windows of 300 frames per person overlapping by 30 (written "
@@ -340,13 +499,21 @@ int reconstruct_multiview_command(int argc, char** argv) {
   std::string fit = args.get("fit");
   if (fit != "auto" && fit != "off" && fit != "live" && fit != "full")
     throw InputError("--fit", "expected auto, off, live or full, got '" + fit + "'");
-  if (fit == "auto") fit = "full";  // every view is a file (JSON, video, images): fitted offline
 
   // Everything that can be checked before DIR is touched.
   const camera::Rig rig = camera::read_rig(rig_file);
   if (const std::string problem = camera::rig_problem(rig); !problem.empty())
     throw InputError(rig_file, problem);
   std::vector<View> views = match_views(rig, args.positionals(), rig_file);
+  refuse_mixed_views(views);
+  const bool live = views.front().kind == ViewKind::camera;
+  if (fit == "auto") fit = live ? "live" : "full";  // files are fitted offline, cameras with a lag
+  std::string detector = args.get("detector");
+  if (detector == "auto") detector = std::string(live ? kLiveDetector : kFileDetector);
+  if (live && args.has("offsets"))
+    throw InputError("--offsets",
+                     "cameras are joined by the time they took their frames: "
+                     "--offsets is for files filmed without a common clock");
   std::vector<NamedPath> inputs = {{"--calibration", rig_file}};
   for (const View& v : views) inputs.push_back({"VIEW", v.path});
   refuse_output_over_inputs({"--out", out.string()}, inputs);
@@ -354,9 +521,15 @@ int reconstruct_multiview_command(int argc, char** argv) {
     refuse_output_over_inputs({"--out", (out / name).string()}, inputs);
   double fps = args.has("fps") ? args.number("fps") : 0.0;
   std::int64_t frames = 0;
+  // Opening a GigE camera starts Aravis' threads, which outlive it: they must inherit the stop
+  // signals blocked, as the graph's signal watcher wants every thread (graph/signals.hpp), or a
+  // Ctrl-C reaching one of them would end the process without its files' last words.
+  if (live) block_stop_signals();
   for (View& v : views) {
     if (v.kind == ViewKind::openpose_json)
       check_json_view(v, rig_file);
+    else if (v.kind == ViewKind::camera)
+      check_camera_view(v, rig_file, args);
     else
       check_video_view(v, rig_file, args);
     if (fps <= 0.0 && v.fps > 0.0) fps = v.fps;
@@ -373,7 +546,7 @@ int reconstruct_multiview_command(int argc, char** argv) {
 
   graph::load_plugins_from_environment();
   graph::GraphSpec spec = graph::parse_graph_text(
-      graph_text(views, rig_file, out, fps, args.get("detector"), trc_world_up, fit),
+      graph_text(views, rig_file, out, fps, detector, trc_world_up, fit, args),
       "mocap reconstruct");
   graph::apply_overrides(spec, args.all("set"));
   check_detector_model(spec);
@@ -400,7 +573,7 @@ int reconstruct_multiview_command(int argc, char** argv) {
   for (const View& v : views) {
     view_list.push_back({{"camera", v.camera->name},
                          {"path", v.path},
-                         {"kind", v.kind == ViewKind::video ? "video" : "openpose_json"},
+                         {"kind", kind_name(v)},
                          {"frames", v.frames},
                          {"offset", offsets_json(v)}});
   }

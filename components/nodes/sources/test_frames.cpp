@@ -20,6 +20,10 @@ class TestFrames : public Node {
     c.param_choice("format", "rgb8", {"gray8", "rgb8", "bgr8", "rgba8", "bgra8"}, "pixel format");
     c.param<double>("fps", 0.0, "frames per second (0: as fast as possible)", {0, 1000});
     c.param<std::string>("camera", std::string(kDefaultCamera), "camera name (also the stream id)");
+    c.param<bool>("aligned", false,
+                  "fps > 0: frames taken at the multiples of the period on the wall clock and "
+                  "stamped with that instant, as cameras triggered together (several such "
+                  "sources share their capture times exactly)");
   }
 
   void open(Context& ctx) override {
@@ -30,13 +34,22 @@ class TestFrames : public Node {
     format_ = pixel_format_from_name(ctx.param<std::string>("format")).value();  // a choice
     const double fps = ctx.param<double>("fps");
     interval_ = std::chrono::nanoseconds(fps > 0 ? static_cast<std::int64_t>(1e9 / fps) : 0);
+    aligned_ = ctx.param<bool>("aligned") && interval_.count() > 0;
   }
 
   void process(Context& ctx) override {
     if (count_ != 0 && seq_ >= count_) return ctx.finish();
-    if (seq_ > 0 && interval_.count() > 0 && !ctx.sleep_for(interval_)) return;
+    std::int64_t capture = 0;
+    if (aligned_) {
+      const std::int64_t period = interval_.count(), now = realtime_ns();
+      capture = (now / period + 1) * period;  // the next multiple of the period
+      if (!ctx.sleep_for(std::chrono::nanoseconds(capture - now))) return;
+    } else {
+      if (seq_ > 0 && interval_.count() > 0 && !ctx.sleep_for(interval_)) return;
+      capture = realtime_ns();
+    }
     VideoFrame frame;
-    frame.header = {camera_, seq_, realtime_ns(), static_cast<std::int64_t>(seq_)};
+    frame.header = {camera_, seq_, capture, static_cast<std::int64_t>(seq_)};
     frame.camera = camera_;
     frame.image = ImageBuffer(width_, height_, format_);
     const auto pixels = frame.image.pixels_for_writing();
@@ -55,6 +68,7 @@ class TestFrames : public Node {
   std::string camera_;
   PixelFormat format_ = PixelFormat::rgb8;
   std::chrono::nanoseconds interval_{0};
+  bool aligned_ = false;
 };
 
 MOCAP_REGISTER_NODE("test.frames", TestFrames)
