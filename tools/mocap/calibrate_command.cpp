@@ -577,7 +577,7 @@ int rig_people_command(int argc, char** argv) {
       ImageSize size{views[i].width, views[i].height};
       if (args.has("size")) {
         size = args.image_size("size");
-      } else if (views[i].kind == PeopleViewKind::openpose_json) {
+      } else if (views[i].kind == InputKind::openpose_json) {
         throw InputError("--hfov", views[i].path +
                                        " is an OpenPose JSON folder: give the images' size "
                                        "(--size WxH)");
@@ -601,9 +601,8 @@ int rig_people_command(int argc, char** argv) {
   const std::string layout = args.get("layout");
   if (layout != "auto" && layout != "BODY_25" && layout != "BODY_25B")
     throw InputError("--layout", "expected auto, BODY_25 or BODY_25B, got '" + layout + "'");
-  const bool detecting = std::any_of(views.begin(), views.end(), [](const PeopleView& v) {
-    return v.kind == PeopleViewKind::video;
-  });
+  const bool detecting = std::any_of(
+      views.begin(), views.end(), [](const PeopleView& v) { return v.kind == InputKind::video; });
   if (detecting) {
     if (args.has("keypoints")) {
       view_options.keypoints = args.get("keypoints");

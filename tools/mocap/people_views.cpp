@@ -31,24 +31,6 @@ std::string size_text(int width, int height) {
 
 std::string quoted(const std::string& text) { return nlohmann::json(text).dump(); }
 
-PeopleViewKind kind_of(const std::string& path) {
-  std::error_code ec;
-  if (fs::is_directory(path, ec)) {
-    bool images = false;
-    for (const auto& e : fs::directory_iterator(path, ec)) {
-      const std::string name = e.path().filename().string();
-      if (name.ends_with(".json")) return PeopleViewKind::openpose_json;
-      images = images || video::is_image_file_name(name);
-    }
-    if (images) return PeopleViewKind::video;
-    throw InputError(path,
-                     "neither OpenPose JSON files (*.json) nor images (.png, .jpg, ...) here");
-  }
-  if (video::classify(path) == video::SourceKind::file && !fs::exists(path, ec))
-    throw InputError(path, "no such file or folder");
-  return PeopleViewKind::video;
-}
-
 bool holds_keypoints(const fs::path& folder) {
   std::error_code ec;
   for (const auto& e : fs::directory_iterator(folder, ec))
@@ -64,7 +46,7 @@ std::string detection_graph(const std::vector<PeopleView>& views,
   std::ostringstream g;
   g << "graph: calibrate_people_detection\nnodes:\n";
   for (std::size_t i = 0; i < views.size(); ++i) {
-    if (views[i].kind != PeopleViewKind::video) continue;
+    if (views[i].kind != InputKind::video) continue;
     const std::string camera = quoted(cameras[i].name);
     g << "  view_" << i << ": { type: source.video, params: { path: " << quoted(views[i].path)
       << ", mode: offline, camera: " << camera;
@@ -79,7 +61,7 @@ std::string detection_graph(const std::vector<PeopleView>& views,
   }
   g << "edges:\n";
   for (std::size_t i = 0; i < views.size(); ++i) {
-    if (views[i].kind != PeopleViewKind::video) continue;
+    if (views[i].kind != InputKind::video) continue;
     g << "  - [view_" << i << ".frames, detect_" << i << ".in]\n"
       << "  - [detect_" << i << ".out, keep_" << i << ".in]\n";
   }
@@ -92,7 +74,7 @@ std::string progress_text(const graph::GraphStats& stats, const std::vector<Peop
   std::ostringstream line;
   double done = 0.0, total = 0.0;
   for (std::size_t i = 0; i < views.size(); ++i) {
-    if (views[i].kind != PeopleViewKind::video) continue;
+    if (views[i].kind != InputKind::video) continue;
     std::uint64_t in = 0;
     for (const auto& n : stats.nodes)
       if (n.node == "keep_" + std::to_string(i)) in = n.in;
@@ -113,8 +95,12 @@ std::vector<PeopleView> open_people_views(const std::vector<std::string>& paths,
   for (const std::string& path : paths) {
     PeopleView& v = views.emplace_back();
     v.path = path;
-    v.kind = kind_of(path);
-    if (v.kind == PeopleViewKind::openpose_json) {
+    v.kind = input_kind(path);
+    if (v.kind == InputKind::camera)
+      throw InputError(path,
+                       "a live camera cannot be a view of calibration from people: record a video "
+                       "from each camera at the same time, then give the videos");
+    if (v.kind == InputKind::openpose_json) {
       v.json = path;
       continue;
     }
@@ -138,7 +124,7 @@ void check_people_views(const std::vector<PeopleView>& views,
   std::optional<std::size_t> first_video, first_known_length;
   for (std::size_t i = 0; i < views.size(); ++i) {
     const PeopleView& v = views[i];
-    if (v.kind != PeopleViewKind::video) continue;
+    if (v.kind != InputKind::video) continue;
     const camera::Camera& c = cameras[i];
     if (v.width != c.width || v.height != c.height)
       throw InputError(c.name, v.path + " is " + size_text(v.width, v.height) + " but camera '" +
@@ -179,7 +165,7 @@ void detect_people(std::vector<PeopleView>& views, const std::vector<camera::Cam
   bool any = false;
   for (std::size_t i = 0; i < views.size(); ++i) {
     PeopleView& v = views[i];
-    if (v.kind != PeopleViewKind::video) continue;
+    if (v.kind != InputKind::video) continue;
     any = true;
     v.json = options.keypoints / cameras[i].name;
     if (!holds_keypoints(v.json)) continue;

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "camera/camera.hpp"
+#include "input_kind.hpp"
 
 namespace mocap::cli {
 
@@ -24,11 +25,9 @@ struct PeopleViewsOptions {
   bool quiet = false;                      // no progress
 };
 
-enum class PeopleViewKind { openpose_json, video };
-
 struct PeopleView {
   std::string path;  // as given
-  PeopleViewKind kind = PeopleViewKind::openpose_json;
+  InputKind kind = InputKind::openpose_json;
   int width = 0, height = 0;   // videos: their frames' size
   bool image_folder = false;   // a folder of images: no frame rate of its own
   double fps = 0.0;            // videos: their rate (image folders: the one given, else 30)

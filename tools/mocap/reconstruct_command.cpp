@@ -39,6 +39,7 @@
 #include "graph/plugins.hpp"
 #include "graph/validation.hpp"
 #include "graph_runner.hpp"
+#include "input_kind.hpp"
 #include "io/openpose_json.hpp"
 #include "output_files.hpp"
 #include "posedb/database.hpp"
@@ -64,28 +65,6 @@ void set_param(graph::GraphSpec& spec, std::string_view type, const std::string&
   for (auto& node : spec.nodes) {
     if (node.type == type) node.params[param] = {value, {"mocap reconstruct", 0}};
   }
-}
-
-// What the input is: a folder of OpenPose JSON, or anything source.video reads (a video file, a
-// camera device, a stream URL, a folder of images).
-enum class InputKind { openpose_json, video };
-
-InputKind input_kind(const std::string& input) {
-  std::error_code ec;
-  if (fs::is_directory(input, ec)) {
-    bool images = false;
-    for (const auto& e : fs::directory_iterator(input, ec)) {
-      const std::string name = e.path().filename().string();
-      if (name.ends_with("_keypoints.json")) return InputKind::openpose_json;
-      images = images || video::is_image_file_name(name);
-    }
-    if (images) return InputKind::video;
-    throw InputError(input,
-                     "neither OpenPose *_keypoints.json files nor images (.png, .jpg, ...) here");
-  }
-  if (video::classify(input) == video::SourceKind::file && !fs::exists(input, ec))
-    throw InputError(input, "no such file or folder");
-  return InputKind::video;
 }
 
 std::string number(double value) {
@@ -568,7 +547,9 @@ int reconstruct_command(int argc, char** argv) {
   const fs::path out = args.get("out");
 
   // Everything that can be checked before DIR is touched.
-  const InputKind kind = input_kind(input);
+  // A camera (device, stream) is read by source.video like a file: the graph is the same.
+  const InputKind given = input_kind(input);
+  const InputKind kind = given == InputKind::camera ? InputKind::video : given;
   refuse_output_over_inputs({"--out", out.string()}, {{"INPUT", input}});
   check_database_and_camera(args);
   const VideoInfo info = kind == InputKind::video ? probe_video(args) : VideoInfo{};

@@ -32,6 +32,7 @@
 #include "graph/plugins.hpp"
 #include "graph/validation.hpp"
 #include "graph_runner.hpp"
+#include "input_kind.hpp"
 #include "io/openpose_json.hpp"
 #include "multiview/rig_reconstruction.hpp"
 #include "output_files.hpp"
@@ -48,11 +49,10 @@ using nlohmann::json;
 
 // Files are joined by frame number; cameras (V4L2 devices, streams, GigE/USB3 Vision) are live and
 // joined by capture time.
-enum class ViewKind { openpose_json, video, camera };
+using ViewKind = InputKind;
 
 // A GigE Vision / USB3 Vision camera as a view: aravis:ID, the ID being what `mocap camera list`
 // shows (device id, serial or address) and what source.aravis's `id` takes.
-constexpr std::string_view kAravisPrefix = "aravis:";
 
 struct View {
   std::string path;
@@ -64,28 +64,6 @@ struct View {
   std::int64_t frame_offset = 0;                // added to the view's frame numbers (--offsets)
   std::optional<camera::ViewOffset> estimated;  // --offsets auto
 };
-
-ViewKind view_kind(const std::string& path) {
-  if (path.starts_with(kAravisPrefix)) return ViewKind::camera;
-  const video::SourceKind source = video::classify(path);
-  if (source == video::SourceKind::device || source == video::SourceKind::network)
-    return ViewKind::camera;
-  std::error_code ec;
-  if (fs::is_directory(path, ec)) {
-    bool images = false;
-    for (const auto& e : fs::directory_iterator(path, ec)) {
-      const std::string name = e.path().filename().string();
-      if (name.ends_with(".json")) return ViewKind::openpose_json;
-      images = images || video::is_image_file_name(name);
-    }
-    if (images) return ViewKind::video;
-    throw InputError(path,
-                     "neither OpenPose JSON files (*.json) nor images (.png, .jpg, ...) here");
-  }
-  if (video::classify(path) == video::SourceKind::file && !fs::exists(path, ec))
-    throw InputError(path, "no such file or folder");
-  return ViewKind::video;
-}
 
 std::string size_text(int width, int height) {
   return std::to_string(width) + "x" + std::to_string(height);
@@ -240,7 +218,7 @@ std::vector<View> match_views(const camera::Rig& rig, const std::vector<std::str
   for (std::size_t i = 0; i < paths.size(); ++i) {
     View& v = views.emplace_back();
     v.path = paths[i];
-    v.kind = view_kind(paths[i]);
+    v.kind = input_kind(paths[i]);
     v.aravis = paths[i].starts_with(kAravisPrefix);
     v.camera = &rig.cameras[i];
   }
