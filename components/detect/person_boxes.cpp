@@ -30,7 +30,7 @@ bool same_keypoints(const MovenetPerson& a, const MovenetPerson& b, float near) 
 
 }  // namespace
 
-Box2D keypoint_box(const std::array<Keypoint2D, kMovenetKeypoints>& keypoints, float margin) {
+Box2D keypoint_box(std::span<const Keypoint2D> keypoints, float margin) {
   float x0 = std::numeric_limits<float>::max(), y0 = x0;
   float x1 = std::numeric_limits<float>::lowest(), y1 = x1;
   for (const Keypoint2D& k : keypoints) {

@@ -11,11 +11,11 @@
 
 namespace mocap::detect {
 
-// The box of the keypoints present (NaN-free, confidence > 0), widened to the whole person: the
-// keypoints stop at the eyes, wrists and ankles, so the box grows by `margin` of its height above
-// (the top of the head) and half of that below and on each side. Empty (0 × 0 at the origin)
-// without keypoints.
-Box2D keypoint_box(const std::array<Keypoint2D, kMovenetKeypoints>& keypoints, float margin);
+// The box of the keypoints (or landmarks) present (NaN-free, confidence > 0), widened to the whole
+// person: the keypoints stop at the eyes, wrists and ankles, so the box grows by `margin` of its
+// height above (the top of the head) and half of that below and on each side. Empty (0 × 0 at the
+// origin) without keypoints.
+Box2D keypoint_box(std::span<const Keypoint2D> keypoints, float margin);
 
 // People in score order, each dropped when its box overlaps a kept one by more than max_iou or
 // when half of the keypoints both have lie within `near` × the kept person's box height.

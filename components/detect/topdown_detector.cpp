@@ -92,6 +92,29 @@ CropVerdict judge_crop(const SinglePose& pose, const TopDownOptions& options) {
   return v;
 }
 
+Box2D posed_box(const SinglePose& pose, const SquareRegion& region, const TopDownOptions& options,
+                float margin) {
+  const auto in_frame = [&](const std::array<float, 3>& point) {
+    const auto& [y, x, score] = point;
+    return Keypoint2D{region.cx - region.side / 2 + x * region.side,
+                      region.cy - region.side / 2 + y * region.side, score};
+  };
+  std::array<Keypoint2D, kBlazePoseBody> points{};
+  std::size_t count = 0;
+  if (options.box_landmark_presence <= 1.0f) {
+    const auto body = std::span(pose.body).first(static_cast<std::size_t>(pose.body_landmarks));
+    for (const auto& landmark : body)
+      if (landmark[2] >= options.box_landmark_presence) points[count++] = in_frame(landmark);
+  }
+  // Fewer than two landmarks span no box: the kept keypoints' then (MoveNet's always).
+  if (count < 2) {
+    count = 0;
+    for (const auto& keypoint : pose.keypoints)
+      if (keypoint[2] >= options.min_keypoint_score) points[count++] = in_frame(keypoint);
+  }
+  return keypoint_box(std::span(points).first(count), margin);
+}
+
 TopDownDetector::TopDownDetector(const TopDownOptions& options,
                                  const std::filesystem::path& pose_model_json,
                                  const std::filesystem::path& centernet_json)
@@ -200,7 +223,7 @@ void TopDownDetector::people_found(std::vector<Found>& found) const {
     const bool sure = options_.sure_box_score > 0 && box_score >= options_.sure_box_score;
     if (!posed && !sure) continue;
     // Keypoints too unsure to outline the person: the detector's box does.
-    person.box = posed ? keypoint_box(person.keypoints, kHeadMargin) : crop_boxes_[i];
+    person.box = posed ? posed_box(found_[i], r, options_, kHeadMargin) : crop_boxes_[i];
     found.push_back({person, 0, box_score, posed});
   }
 }

@@ -58,6 +58,11 @@ struct TopDownOptions {
   // this instead (MediaPipe's threshold on it, 0.5); the keypoints kept are still those scoring
   // min_keypoint_score.
   float min_pose_presence = 0.5f;
+  // Models with landmark presence (BlazePose): a posed person's box (and so their next crop) spans
+  // the body landmarks whose presence reaches this (MediaPipe's 0.5), hidden or blurred legs
+  // included, while the keypoints emitted are still those scoring min_keypoint_score. Above 1:
+  // the box of the emitted keypoints, as for MoveNet.
+  float box_landmark_presence = 0.5f;
   // A person the detector is sure of: a box scoring at least this is a person even when its
   // crop's keypoints fail the test above (blurred or crowded people); only the keypoints scoring
   // min_keypoint_score are kept, and the box is the detector's. Such a person is followed until
@@ -91,6 +96,13 @@ struct CropVerdict {
   bool posed = false;
 };
 CropVerdict judge_crop(const SinglePose& pose, const TopDownOptions& options);
+
+// The box of a posed person cut from `region`: with BlazePose (and box_landmark_presence <= 1),
+// that of the body landmarks whose presence reaches box_landmark_presence when at least two do;
+// otherwise that of the keypoints scoring min_keypoint_score; both widened by `margin` as
+// keypoint_box does. Frame pixels.
+Box2D posed_box(const SinglePose& pose, const SquareRegion& region, const TopDownOptions& options,
+                float margin);
 
 // Where the time of detect() went, summed over the frames since the detector was made (seconds,
 // wall clock). CenterNet runs on a helper thread when there are several workers, then overlapping

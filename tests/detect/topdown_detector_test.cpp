@@ -190,6 +190,52 @@ TEST(TopDownDetector, APresenceFlagIsThePersonTestOfTheModelsThatHaveOne) {
   EXPECT_FALSE(judge_crop(pose, o).posed);
 }
 
+// BlazePose's person box (posed_box): the landmarks whose presence passes, blurred legs included,
+// while the keypoints emitted keep their visibility; MoveNet's, or too few present landmarks, the
+// kept keypoints'. Synthetic outputs of one 256-px crop, so that every number is known.
+TEST(TopDownDetector, ABlazePoseBoxReachesTheFeetItsLandmarksPlace) {
+  constexpr int kSize = 256;
+  GraphTensor landmarks{{1, kBlazePoseLandmarks * 5}, {}}, flag{{1, 1, 1, 1}, {0.9f}};
+  landmarks.values.assign(landmarks.size(), 0.0f);
+  const auto set = [&](int k, float x, float y, float visibility, float presence) {
+    float* l = landmarks.values.data() + k * 5;
+    l[0] = x, l[1] = y, l[3] = visibility, l[4] = presence;  // logits
+  };
+  // A standing person along x = 128 px, landmark k at y = 40 + 5 k (toes at 200); the legs from
+  // the knees down (25-32) are blurred (visibility σ(-3)) but present (σ(3)).
+  for (int k = 0; k < kBlazePoseBody; ++k) set(k, 128, 40 + 5.0f * k, k >= 25 ? -3 : 3, 3);
+  set(19, 250, 135, -3, -3);  // a hand outside the picture: not present, left out
+  set(20, 20, 140, -3, 3);    // a hand hidden but present: in the box, not a keypoint
+  const SinglePose pose = decode_blazepose(landmarks, flag, kSize, 0);
+  EXPECT_EQ(pose.body_landmarks, kBlazePoseBody);
+  EXPECT_NEAR(pose.body[32][2], 1 / (1 + std::exp(-3.0f)), 1e-6);
+  EXPECT_LT(pose.keypoints[15][2], 0.3f);  // the ankles keep their visibility: not emitted
+  EXPECT_GT(pose.keypoints[11][2], 0.3f);
+
+  const SquareRegion region{500, 300, kSize};  // crop pixel (x, y) is frame (372 + x, 172 + y)
+  const auto expect_box = [](const Box2D& got, Box2D want) {
+    EXPECT_NEAR(got.x, want.x, 1e-3);
+    EXPECT_NEAR(got.y, want.y, 1e-3);
+    EXPECT_NEAR(got.width, want.width, 1e-3);
+    EXPECT_NEAR(got.height, want.height, 1e-3);
+  };
+  TopDownOptions o;                                                 // box_landmark_presence 0.5
+  expect_box(posed_box(pose, region, o, 0), {392, 212, 108, 160});  // toes at 372, hand 20 at 392
+  // Margin as keypoint_box's: 0.1 of the taller side (160) above, half of it below and aside.
+  expect_box(posed_box(pose, region, o, 0.1f), {384, 196, 124, 184});
+  o.box_landmark_presence = 2;  // off: the kept keypoints, nose (212) to hips (24: 332)
+  expect_box(posed_box(pose, region, o, 0), {500, 212, 0, 120});
+  o.box_landmark_presence = 0.5f;
+  SinglePose one = pose;  // a single landmark present spans no box: the keypoints' again
+  for (auto& l : one.body) l[2] = 0.1f;
+  one.body[32][2] = 0.9f;
+  expect_box(posed_box(one, region, o, 0), {500, 212, 0, 120});
+  SinglePose movenet = pose;  // no landmarks: the keypoints'
+  movenet.body_landmarks = 0;
+  movenet.presence = kNoPresence;
+  expect_box(posed_box(movenet, region, o, 0), {500, 212, 0, 120});
+}
+
 // BlazePose lite in the crops: the pedestrians of vtest frame 300, each with a presence flag of
 // at least MediaPipe's 0.5 as the person score, their keypoints confident ones only.
 TEST(TopDownDetector, BlazePoseFindsThePedestriansOfFrame300) {

@@ -100,13 +100,15 @@ Strategy make_strategy(const std::string& spec, detect::Backend backend, int thr
       o.pose_model = detect::parse_pose_model(parts[1]);
     } catch (const std::invalid_argument&) {
       throw std::invalid_argument(
-          "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:kEVERY][:uSURE] with "
+          "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:kEVERY][:uSURE][:"
+          "bPRESENCE] with "
           "MODEL " +
           std::string(detect::pose_model_names()) + ", got " + spec);
     }
     o.detect_every = std::stoi(parts[2]);
     // Then WORKERS and THREADS, and anywhere tN (person detector on N tiles; tNw: and the whole
-    // frame), sX (its score threshold), kK (keypoint pass every K frames) and uX (sure_box_score).
+    // frame), sX (its score threshold), kK (keypoint pass every K frames), uX (sure_box_score) and
+    // bX (box_landmark_presence).
     std::vector<std::string> numbers;
     for (std::size_t i = 3; i < parts.size(); ++i) {
       if (parts[i].size() > 1 && parts[i][0] == 't') {
@@ -116,6 +118,8 @@ Strategy make_strategy(const std::string& spec, detect::Backend backend, int thr
         o.sure_box_score = std::stof(parts[i].substr(1));
       else if (parts[i].size() > 1 && parts[i][0] == 's')
         o.min_box_score = std::stof(parts[i].substr(1));
+      else if (parts[i].size() > 1 && parts[i][0] == 'b')
+        o.box_landmark_presence = std::stof(parts[i].substr(1));
       else if (parts[i].size() > 1 && parts[i][0] == 'k')
         o.keypoint_every = std::stoi(parts[i].substr(1));
       else
@@ -123,7 +127,8 @@ Strategy make_strategy(const std::string& spec, detect::Backend backend, int thr
     }
     if (numbers.size() > 2)
       throw std::invalid_argument(
-          "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:kEVERY][:uSURE], got " +
+          "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:kEVERY][:uSURE][:"
+          "bPRESENCE], got " +
           spec);
     o.backend = backend;
     o.threads = numbers.size() == 2 ? std::stoi(numbers[1]) : threads;
@@ -138,7 +143,7 @@ Strategy make_strategy(const std::string& spec, detect::Backend backend, int thr
   throw std::invalid_argument(
       "unknown strategy '" + spec +
       "' (multipose:SIZE, tiles:CxR:TILE:FRAME, "
-      "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:kEVERY][:uSURE])");
+      "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:kEVERY][:uSURE][:bPRESENCE])");
 }
 
 // Every frame of a video, or the one image of a still.
@@ -476,11 +481,13 @@ int main(int argc, char** argv) {
               "multipose:SIZE, "
               "tiles:CxR:TILE:FRAME, "
               "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:kEVERY][:"
-              "uSURE] "
+              "uSURE][:bPRESENCE] "
               "(MODEL: lightning, thunder, blazepose-lite, blazepose-full, blazepose-heavy; "
               "workers: copies of the keypoint network sharing a frame's crops; tTILES: person "
               "detector tiles, tTILESw: and the whole frame, sSCORE: its box score floor, uSURE: "
-              "boxes scoring SURE are people whatever their keypoints, kEVERY: keypoint pass every "
+              "boxes scoring SURE are people whatever their keypoints, bPRESENCE: BlazePose "
+              "boxes from the landmarks of this presence (default 0.5; above 1: from the kept "
+              "keypoints), kEVERY: keypoint pass every "
               "EVERY "
               "frames, optical flow between; a top-down "
               "strategy also prints where its time went)",
