@@ -341,6 +341,7 @@ void diagnose(const std::string& input, const eval::DetectionTruth& truth, const
   std::map<std::string, int> causes;
   std::map<std::string, std::pair<int, int>> by_height;  // found, all
   std::array<int, 3> nearest{};                          // misses by nearest IoU bucket
+  std::array<int, 3> loose{};  // (d) by the nearest box's height: < 0.9, 0.9-1.1, > 1.1 x true
   int truths = 0;
   Frames frames(input);
   for (int i = 0;; ++i) {
@@ -374,8 +375,9 @@ void diagnose(const std::string& input, const eval::DetectionTruth& truth, const
         by_height[band].first++;
         continue;
       }
-      float near = 0;
-      for (const Box2D& b : found) near = std::max(near, detect::iou(b, box));
+      float near = 0, near_height = 0;
+      for (const Box2D& b : found)
+        if (const float v = detect::iou(b, box); v > near) near = v, near_height = b.height;
       nearest[near < 0.1f ? 0 : near < 0.3f ? 1 : 2]++;
       float best_score = -1, best_iou = 0.3f;    // the best proposal near the box
       const detect::Detection* above = nullptr;  // the nearest passing the threshold
@@ -387,6 +389,8 @@ void diagnose(const std::string& input, const eval::DetectionTruth& truth, const
       }
       if (near >= 0.3f) {
         causes["(d) found, box IoU 0.3-0.5"]++;
+        const float ratio = near_height / box.height;
+        loose[ratio < 0.9f ? 0 : ratio <= 1.1f ? 1 : 2]++;
       } else if (best_score < 0) {
         causes["(a) no proposal near it"]++;
       } else if (!above) {
@@ -428,8 +432,9 @@ void diagnose(const std::string& input, const eval::DetectionTruth& truth, const
               static_cast<double>(alone_matched) / std::max(1, alone_counted));
   std::printf(
       "\nMisses by the IoU of the nearest found person: < 0.1: %d, 0.1-0.3: %d, "
-      "0.3-0.5: %d\n\n| true height | recall |\n|---|---|\n",
-      nearest[0], nearest[1], nearest[2]);
+      "0.3-0.5: %d (its box's height < 0.9 x the true one: %d, 0.9-1.1: %d, > 1.1: %d)\n\n"
+      "| true height | recall |\n|---|---|\n",
+      nearest[0], nearest[1], nearest[2], loose[0], loose[1], loose[2]);
   for (const auto& [band, n] : by_height)
     std::printf("| %s | %d / %d |\n", band.c_str(), n.first, n.second);
   std::fflush(stdout);
