@@ -93,7 +93,7 @@ CropVerdict judge_crop(const SinglePose& pose, const TopDownOptions& options) {
 }
 
 Box2D posed_box(const SinglePose& pose, const SquareRegion& region, const TopDownOptions& options,
-                float margin) {
+                int frame_width, int frame_height) {
   const auto in_frame = [&](const std::array<float, 3>& point) {
     const auto& [y, x, score] = point;
     return Keypoint2D{region.cx - region.side / 2 + x * region.side,
@@ -105,6 +105,9 @@ Box2D posed_box(const SinglePose& pose, const SquareRegion& region, const TopDow
     const auto body = std::span(pose.body).first(static_cast<std::size_t>(pose.body_landmarks));
     for (const auto& landmark : body)
       if (landmark[2] >= options.box_landmark_presence) points[count++] = in_frame(landmark);
+    if (count >= 2 && options.anatomical_landmark_box)
+      return clip_box(points_box(std::span(points).first(count), kLandmarkBoxMargins),
+                      static_cast<float>(frame_width), static_cast<float>(frame_height));
   }
   // Fewer than two landmarks span no box: the kept keypoints' then (MoveNet's always).
   if (count < 2) {
@@ -112,7 +115,7 @@ Box2D posed_box(const SinglePose& pose, const SquareRegion& region, const TopDow
     for (const auto& keypoint : pose.keypoints)
       if (keypoint[2] >= options.min_keypoint_score) points[count++] = in_frame(keypoint);
   }
-  return keypoint_box(std::span(points).first(count), margin);
+  return keypoint_box(std::span(points).first(count), kHeadMargin);
 }
 
 TopDownDetector::TopDownDetector(const TopDownOptions& options,
@@ -205,7 +208,7 @@ void TopDownDetector::add_crops(const ImageBuffer& frame, std::span<const Box2D>
   run_keypoints(first, count, copies);
   profile_.keypoints += seconds_since(start);
 }
-void TopDownDetector::people_found(std::vector<Found>& found) const {
+void TopDownDetector::people_found(const ImageBuffer& frame, std::vector<Found>& found) const {
   for (std::size_t i = 0; i < found_.size(); ++i) {
     const SquareRegion& r = regions_[i];
     MovenetPerson person;
@@ -223,7 +226,8 @@ void TopDownDetector::people_found(std::vector<Found>& found) const {
     const bool sure = options_.sure_box_score > 0 && box_score >= options_.sure_box_score;
     if (!posed && !sure) continue;
     // Keypoints too unsure to outline the person: the detector's box does.
-    person.box = posed ? posed_box(found_[i], r, options_, kHeadMargin) : crop_boxes_[i];
+    person.box =
+        posed ? posed_box(found_[i], r, options_, frame.width(), frame.height()) : crop_boxes_[i];
     found.push_back({person, 0, box_score, posed});
   }
 }
@@ -357,7 +361,7 @@ std::vector<MovenetPerson> TopDownDetector::detect(const ImageBuffer& frame) {
     }
   }
   add_crops(frame, std::span<const Box2D>(boxes).subspan(cropped), copies);
-  people_found(found);
+  people_found(frame, found);
   std::vector<MovenetPerson> people;
   std::vector<std::size_t> kept;  // per person: their index in `found`
   {

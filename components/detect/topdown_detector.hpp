@@ -29,6 +29,7 @@
 #include "detect/keypoint_flow.hpp"
 #include "detect/movenet_decoder.hpp"
 #include "detect/ordered_workers.hpp"
+#include "detect/person_boxes.hpp"
 #include "detect/singlepose.hpp"
 
 namespace mocap::detect {
@@ -63,6 +64,10 @@ struct TopDownOptions {
   // included, while the keypoints emitted are still those scoring min_keypoint_score. Above 1:
   // the box of the emitted keypoints, as for MoveNet.
   float box_landmark_presence = 0.5f;
+  // The margins of that landmark box: true, from the body's proportions (posed_box), cut to the
+  // picture; false, the keypoints' widening (12 % above, 6 % below and aside, not cut), kept to
+  // measure the two against each other.
+  bool anatomical_landmark_box = true;
   // A person the detector is sure of: a box scoring at least this is a person even when its
   // crop's keypoints fail the test above (blurred or crowded people); only the keypoints scoring
   // min_keypoint_score are kept, and the box is the detector's. Such a person is followed until
@@ -97,12 +102,22 @@ struct CropVerdict {
 };
 CropVerdict judge_crop(const SinglePose& pose, const TopDownOptions& options);
 
-// The box of a posed person cut from `region`: with BlazePose (and box_landmark_presence <= 1),
-// that of the body landmarks whose presence reaches box_landmark_presence when at least two do;
-// otherwise that of the keypoints scoring min_keypoint_score; both widened by `margin` as
-// keypoint_box does. Frame pixels.
+// The box of a posed person cut from `region` of a `frame_width` × `frame_height` picture, in
+// frame pixels. With BlazePose (and box_landmark_presence <= 1) that of the body landmarks whose
+// presence reaches box_landmark_presence, when at least two do, grown by kLandmarkBoxMargins (with
+// anatomical_landmark_box) and cut to the picture; otherwise that of the keypoints scoring
+// min_keypoint_score widened as keypoint_box does by 0.12 (the top of the head above the eyes).
 Box2D posed_box(const SinglePose& pose, const SquareRegion& region, const TopDownOptions& options,
-                float margin);
+                int frame_width, int frame_height);
+
+// How far a person reaches beyond BlazePose's landmarks, as shares of the landmarks' extent (of a
+// standing person: eyes to soles). The feet's landmarks (heels, toes) lie on the soles: nothing
+// below. The top of the head lies 105-110 mm above the eyes at an eye height of 1505-1630 mm
+// (British women and men, 50th percentile, stature minus eye height in Pheasant's tables): 0.07.
+// Aside, the deltoids reach (465 - 400) / 2 = 32 mm beyond the acromia (bideltoid against
+// biacromial breadth, British men), the shoulder landmark sitting about as far inside them:
+// 0.03 (50 mm of 1630). Chosen from these tables before any run, not fitted.
+inline constexpr BoxMargins kLandmarkBoxMargins{0.07f, 0.0f, 0.03f};
 
 // Where the time of detect() went, summed over the frames since the detector was made (seconds,
 // wall clock). CenterNet runs on a helper thread when there are several workers, then overlapping
@@ -166,7 +181,7 @@ class TopDownDetector {
   // Keypoints of crops_[0, count) into found_[first, first + count), on `copies` copies at once.
   void run_keypoints(int first, int count, int copies);
   // People of the crops of this frame, appended to `found`.
-  void people_found(std::vector<Found>& found) const;
+  void people_found(const ImageBuffer& frame, std::vector<Found>& found) const;
   // The followed people due no keypoint pass moved into this frame by optical flow, appended to
   // `out`; marks in carried_ which were (the others need a crop).
   void carry(std::vector<Found>& out);

@@ -219,21 +219,31 @@ TEST(TopDownDetector, ABlazePoseBoxReachesTheFeetItsLandmarksPlace) {
     EXPECT_NEAR(got.width, want.width, 1e-3);
     EXPECT_NEAR(got.height, want.height, 1e-3);
   };
-  TopDownOptions o;                                                 // box_landmark_presence 0.5
-  expect_box(posed_box(pose, region, o, 0), {392, 212, 108, 160});  // toes at 372, hand 20 at 392
-  // Margin as keypoint_box's: 0.1 of the taller side (160) above, half of it below and aside.
-  expect_box(posed_box(pose, region, o, 0.1f), {384, 196, 124, 184});
-  o.box_landmark_presence = 2;  // off: the kept keypoints, nose (212) to hips (24: 332)
-  expect_box(posed_box(pose, region, o, 0), {500, 212, 0, 120});
+  TopDownOptions o;  // box_landmark_presence 0.5, anatomical_landmark_box
+  // The landmarks span x 392 (hand 20) to 500, y 212 (nose) to 372 (toes): 160 px tall. Grown by
+  // 0.07 of that above (11.2 px), 0.03 on each side (4.8 px), nothing below the toes.
+  expect_box(posed_box(pose, region, o, 1000, 1000), {387.2f, 200.8f, 117.6f, 171.2f});
+  // Cut to a 640 x 360 picture: the feet below its bottom edge are left out.
+  expect_box(posed_box(pose, region, o, 640, 360), {387.2f, 200.8f, 117.6f, 159.2f});
+  // The same person at the picture's top left corner (frame = crop - 28 px): x from -12.8 cut to 0.
+  expect_box(posed_box(pose, {100, 100, kSize}, o, 640, 360), {0, 0.8f, 104.8f, 171.2f});
+  o.anatomical_landmark_box = false;  // the keypoints' widening: 0.12 × 160 above, half below
+  expect_box(posed_box(pose, region, o, 640, 360), {382.4f, 192.8f, 127.2f, 188.8f});
+  o.anatomical_landmark_box = true;
+  // The kept keypoints, nose (212) to hips (24: 332), 120 px, widened as before: 14.4 px above,
+  // 7.2 below and aside, not cut.
+  const Box2D keypoints_box{492.8f, 197.6f, 14.4f, 141.6f};
+  o.box_landmark_presence = 2;  // off
+  expect_box(posed_box(pose, region, o, 640, 300), keypoints_box);
   o.box_landmark_presence = 0.5f;
   SinglePose one = pose;  // a single landmark present spans no box: the keypoints' again
   for (auto& l : one.body) l[2] = 0.1f;
   one.body[32][2] = 0.9f;
-  expect_box(posed_box(one, region, o, 0), {500, 212, 0, 120});
+  expect_box(posed_box(one, region, o, 640, 300), keypoints_box);
   SinglePose movenet = pose;  // no landmarks: the keypoints'
   movenet.body_landmarks = 0;
   movenet.presence = kNoPresence;
-  expect_box(posed_box(movenet, region, o, 0), {500, 212, 0, 120});
+  expect_box(posed_box(movenet, region, o, 640, 300), keypoints_box);
 }
 
 // BlazePose lite in the crops: the pedestrians of vtest frame 300, each with a presence flag of

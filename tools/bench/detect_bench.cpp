@@ -101,14 +101,15 @@ Strategy make_strategy(const std::string& spec, detect::Backend backend, int thr
     } catch (const std::invalid_argument&) {
       throw std::invalid_argument(
           "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:kEVERY][:uSURE][:"
-          "bPRESENCE] with "
+          "bPRESENCE][:m0] with "
           "MODEL " +
           std::string(detect::pose_model_names()) + ", got " + spec);
     }
     o.detect_every = std::stoi(parts[2]);
     // Then WORKERS and THREADS, and anywhere tN (person detector on N tiles; tNw: and the whole
     // frame), sX (its score threshold), kK (keypoint pass every K frames), uX (sure_box_score) and
-    // bX (box_landmark_presence).
+    // bX (box_landmark_presence), m0 (the landmark box widened as the keypoints', not cut to the
+    // picture: anatomical_landmark_box off).
     std::vector<std::string> numbers;
     for (std::size_t i = 3; i < parts.size(); ++i) {
       if (parts[i].size() > 1 && parts[i][0] == 't') {
@@ -120,6 +121,8 @@ Strategy make_strategy(const std::string& spec, detect::Backend backend, int thr
         o.min_box_score = std::stof(parts[i].substr(1));
       else if (parts[i].size() > 1 && parts[i][0] == 'b')
         o.box_landmark_presence = std::stof(parts[i].substr(1));
+      else if (parts[i] == "m0")
+        o.anatomical_landmark_box = false;
       else if (parts[i].size() > 1 && parts[i][0] == 'k')
         o.keypoint_every = std::stoi(parts[i].substr(1));
       else
@@ -128,7 +131,7 @@ Strategy make_strategy(const std::string& spec, detect::Backend backend, int thr
     if (numbers.size() > 2)
       throw std::invalid_argument(
           "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:kEVERY][:uSURE][:"
-          "bPRESENCE], got " +
+          "bPRESENCE][:m0], got " +
           spec);
     o.backend = backend;
     o.threads = numbers.size() == 2 ? std::stoi(numbers[1]) : threads;
@@ -140,10 +143,10 @@ Strategy make_strategy(const std::string& spec, detect::Backend backend, int thr
     return {spec, [d](const ImageBuffer& f) { return d->detect(f); }, [d] { d->reset(); },
             [d] { return d->profile(); }, o};
   }
-  throw std::invalid_argument(
-      "unknown strategy '" + spec +
-      "' (multipose:SIZE, tiles:CxR:TILE:FRAME, "
-      "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:kEVERY][:uSURE][:bPRESENCE])");
+  throw std::invalid_argument("unknown strategy '" + spec +
+                              "' (multipose:SIZE, tiles:CxR:TILE:FRAME, "
+                              "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:"
+                              "kEVERY][:uSURE][:bPRESENCE][:m0])");
 }
 
 // Every frame of a video, or the one image of a still.
@@ -486,13 +489,14 @@ int main(int argc, char** argv) {
               "multipose:SIZE, "
               "tiles:CxR:TILE:FRAME, "
               "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:kEVERY][:"
-              "uSURE][:bPRESENCE] "
+              "uSURE][:bPRESENCE][:m0] "
               "(MODEL: lightning, thunder, blazepose-lite, blazepose-full, blazepose-heavy; "
               "workers: copies of the keypoint network sharing a frame's crops; tTILES: person "
               "detector tiles, tTILESw: and the whole frame, sSCORE: its box score floor, uSURE: "
               "boxes scoring SURE are people whatever their keypoints, bPRESENCE: BlazePose "
               "boxes from the landmarks of this presence (default 0.5; above 1: from the kept "
-              "keypoints), kEVERY: keypoint pass every "
+              "keypoints), m0: that landmark box widened as the keypoints' and not cut to the "
+              "picture (before the anatomical margins), kEVERY: keypoint pass every "
               "EVERY "
               "frames, optical flow between; a top-down "
               "strategy also prints where its time went)",
