@@ -46,7 +46,18 @@ Box2D points_box(std::span<const Keypoint2D> points, const BoxMargins& margins) 
 }
 
 Box2D keypoint_box(std::span<const Keypoint2D> keypoints, float margin) {
-  return points_box(keypoints, {margin, margin / 2, margin / 2});
+  // Not points_box(keypoints, {margin, margin / 2, margin / 2}): its sums round differently in the
+  // last bit, and the boxes feed the tracking, whose results are compared run against run.
+  float x0 = std::numeric_limits<float>::max(), y0 = x0;
+  float x1 = std::numeric_limits<float>::lowest(), y1 = x1;
+  for (const Keypoint2D& k : keypoints) {
+    if (!present(k)) continue;
+    x0 = std::min(x0, k.x), x1 = std::max(x1, k.x);
+    y0 = std::min(y0, k.y), y1 = std::max(y1, k.y);
+  }
+  if (x0 > x1) return {};
+  const float h = y1 - y0, grow = margin * std::max(h, x1 - x0);
+  return {x0 - grow / 2, y0 - grow, (x1 - x0) + grow, h + 1.5f * grow};
 }
 
 Box2D clip_box(const Box2D& box, float width, float height) {

@@ -59,14 +59,15 @@ struct TopDownOptions {
   // this instead (MediaPipe's threshold on it, 0.5); the keypoints kept are still those scoring
   // min_keypoint_score.
   float min_pose_presence = 0.5f;
-  // Models with landmark presence (BlazePose): a posed person's box (and so their next crop) spans
-  // the body landmarks whose presence reaches this (MediaPipe's 0.5), hidden or blurred legs
+  // Models with landmark presence (BlazePose): a posed person's box and their next crop span the
+  // body landmarks whose presence reaches this (MediaPipe's 0.5), hidden or blurred legs
   // included, while the keypoints emitted are still those scoring min_keypoint_score. Above 1:
   // the box of the emitted keypoints, as for MoveNet.
   float box_landmark_presence = 0.5f;
-  // The margins of that landmark box: true, from the body's proportions (posed_box), cut to the
-  // picture; false, the keypoints' widening (12 % above, 6 % below and aside, not cut), kept to
-  // measure the two against each other.
+  // The margins of the person's landmark box: true, from the body's proportions, cut to the
+  // picture (posed_box); false, the keypoints' widening (12 % above, 6 % below and aside, not
+  // cut), kept to measure the two against each other. The crop's box is the latter either way
+  // (posed_crop_box).
   bool anatomical_landmark_box = true;
   // A person the detector is sure of: a box scoring at least this is a person even when its
   // crop's keypoints fail the test above (blurred or crowded people); only the keypoints scoring
@@ -109,6 +110,14 @@ CropVerdict judge_crop(const SinglePose& pose, const TopDownOptions& options);
 // min_keypoint_score widened as keypoint_box does by 0.12 (the top of the head above the eyes).
 Box2D posed_box(const SinglePose& pose, const SquareRegion& region, const TopDownOptions& options,
                 int frame_width, int frame_height);
+
+// The box a posed person's next crop is cut around: that of the same points as posed_box's,
+// always widened by 0.12 as keypoint_box does and not cut to the picture. Wider than BlazePose's
+// person box on purpose: a crop cut tight to the last frame's landmarks loses the feet of a
+// moving person, their presence falls, and box and crop shrink frame after frame (measured in
+// docs/detection-strategies.md, "Boxes from the body's proportions").
+Box2D posed_crop_box(const SinglePose& pose, const SquareRegion& region,
+                     const TopDownOptions& options);
 
 // How far a person reaches beyond BlazePose's landmarks, as shares of the landmarks' extent (of a
 // standing person: eyes to soles). The feet's landmarks (heels, toes) lie on the soles: nothing
@@ -158,7 +167,7 @@ class TopDownDetector {
 
  private:
   struct Followed {
-    Box2D box;             // the person's box in the last frame
+    Box2D box;             // the box their next crop is cut around (posed_crop_box)
     float vx = 0, vy = 0;  // motion of the box centre per frame
     MovenetPerson person;  // their keypoints in the last frame
     int carried = 0;       // frames since their last keypoint pass
@@ -169,6 +178,7 @@ class TopDownDetector {
   // test (or the detector's score alone kept them).
   struct Found {
     MovenetPerson person;
+    Box2D follow;  // the box of their next crop
     int carried = 0;
     float box_score = 0;
     bool posed = true;

@@ -227,8 +227,12 @@ TEST(TopDownDetector, ABlazePoseBoxReachesTheFeetItsLandmarksPlace) {
   expect_box(posed_box(pose, region, o, 640, 360), {387.2f, 200.8f, 117.6f, 159.2f});
   // The same person at the picture's top left corner (frame = crop - 28 px): x from -12.8 cut to 0.
   expect_box(posed_box(pose, {100, 100, kSize}, o, 640, 360), {0, 0.8f, 104.8f, 171.2f});
-  o.anatomical_landmark_box = false;  // the keypoints' widening: 0.12 × 160 above, half below
-  expect_box(posed_box(pose, region, o, 640, 360), {382.4f, 192.8f, 127.2f, 188.8f});
+  // The next crop's box: the keypoints' widening, 0.12 × 160 above, half below and aside, not
+  // cut; with anatomical_landmark_box off the person's box too.
+  const Box2D widened{382.4f, 192.8f, 127.2f, 188.8f};
+  expect_box(posed_crop_box(pose, region, o), widened);
+  o.anatomical_landmark_box = false;
+  expect_box(posed_box(pose, region, o, 640, 360), widened);
   o.anatomical_landmark_box = true;
   // The kept keypoints, nose (212) to hips (24: 332), 120 px, widened as before: 14.4 px above,
   // 7.2 below and aside, not cut.
@@ -244,6 +248,7 @@ TEST(TopDownDetector, ABlazePoseBoxReachesTheFeetItsLandmarksPlace) {
   movenet.body_landmarks = 0;
   movenet.presence = kNoPresence;
   expect_box(posed_box(movenet, region, o, 640, 300), keypoints_box);
+  expect_box(posed_crop_box(movenet, region, o), keypoints_box);
 }
 
 // BlazePose lite in the crops: the pedestrians of vtest frame 300, each with a presence flag of
