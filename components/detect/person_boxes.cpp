@@ -30,7 +30,24 @@ bool same_keypoints(const MovenetPerson& a, const MovenetPerson& b, float near) 
 
 }  // namespace
 
-Box2D keypoint_box(const std::array<Keypoint2D, kMovenetKeypoints>& keypoints, float margin) {
+Box2D points_box(std::span<const Keypoint2D> points, const BoxMargins& margins) {
+  float x0 = std::numeric_limits<float>::max(), y0 = x0;
+  float x1 = std::numeric_limits<float>::lowest(), y1 = x1;
+  for (const Keypoint2D& k : points) {
+    if (!present(k)) continue;
+    x0 = std::min(x0, k.x), x1 = std::max(x1, k.x);
+    y0 = std::min(y0, k.y), y1 = std::max(y1, k.y);
+  }
+  if (x0 > x1) return {};
+  const float extent = std::max(y1 - y0, x1 - x0);
+  const float top = margins.top * extent, bottom = margins.bottom * extent;
+  const float side = margins.side * extent;
+  return {x0 - side, y0 - top, (x1 - x0) + 2 * side, (y1 - y0) + top + bottom};
+}
+
+Box2D keypoint_box(std::span<const Keypoint2D> keypoints, float margin) {
+  // Not points_box(keypoints, {margin, margin / 2, margin / 2}): its sums round differently in the
+  // last bit, and the boxes feed the tracking, whose results are compared run against run.
   float x0 = std::numeric_limits<float>::max(), y0 = x0;
   float x1 = std::numeric_limits<float>::lowest(), y1 = x1;
   for (const Keypoint2D& k : keypoints) {
@@ -41,6 +58,13 @@ Box2D keypoint_box(const std::array<Keypoint2D, kMovenetKeypoints>& keypoints, f
   if (x0 > x1) return {};
   const float h = y1 - y0, grow = margin * std::max(h, x1 - x0);
   return {x0 - grow / 2, y0 - grow, (x1 - x0) + grow, h + 1.5f * grow};
+}
+
+Box2D clip_box(const Box2D& box, float width, float height) {
+  const float x0 = std::clamp(box.x, 0.0f, width), x1 = std::clamp(box.x + box.width, 0.0f, width);
+  const float y0 = std::clamp(box.y, 0.0f, height);
+  const float y1 = std::clamp(box.y + box.height, 0.0f, height);
+  return {x0, y0, x1 - x0, y1 - y0};
 }
 
 std::vector<std::size_t> distinct_people(std::span<const MovenetPerson> people, float max_iou,

@@ -119,6 +119,11 @@ SinglePose decode_blazepose(const GraphTensor& landmarks, const GraphTensor& fla
     const float* l = v + static_cast<std::size_t>(kBlazePoseToCoco[k]) * kBlazePoseValues;
     out.keypoints[k] = {l[1] * scale, l[0] * scale, sigmoid(l[3])};
   }
+  for (int k = 0; k < kBlazePoseBody; ++k) {
+    const float* l = v + static_cast<std::size_t>(k) * kBlazePoseValues;
+    out.body[static_cast<std::size_t>(k)] = {l[1] * scale, l[0] * scale, sigmoid(l[4])};
+  }
+  out.body_landmarks = kBlazePoseBody;
   out.presence = flag.values[static_cast<std::size_t>(n)];
   return out;
 }
@@ -242,7 +247,7 @@ void SinglePoseNetwork::run(const GraphTensor& crops, int first, int count,
       if (is_blazepose(model_))
         o = decode_blazepose(heads[0], heads[1], input_size(), n);
       else
-        o = {decode_singlepose(heads[0], heads[1], heads[2], heads[3], n), kNoPresence};
+        o = {decode_singlepose(heads[0], heads[1], heads[2], heads[3], n), kNoPresence, {}, 0};
     }
     done += pass;
   }

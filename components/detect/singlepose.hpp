@@ -56,9 +56,15 @@ using SinglePoseKeypoints = std::array<std::array<float, 3>, kMovenetKeypoints>;
 // One crop's answer: its keypoints and, from models that have one (BlazePose), the network's
 // pose-presence flag in [0, 1]; kNoPresence for MoveNet, whose person test is its keypoints'.
 inline constexpr float kNoPresence = -1.0f;
+// BlazePose's 33 body landmarks (MediaPipe's order: head, arms, hands, legs, heels, toes), each
+// (y, x normalised to the crop, σ(presence): the landmark lies in the picture, seen or occluded).
+inline constexpr int kBlazePoseBody = 33;
+using BodyLandmarks = std::array<std::array<float, 3>, kBlazePoseBody>;
 struct SinglePose {
   SinglePoseKeypoints keypoints{};
   float presence = kNoPresence;
+  BodyLandmarks body{};    // BlazePose only
+  int body_landmarks = 0;  // kBlazePoseBody from BlazePose, 0 from MoveNet
 };
 
 // BlazePose: the 39 landmarks the model outputs (33 of the body, 6 auxiliary), 5 values each.

@@ -6,6 +6,7 @@
 #include <exception>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "detect/image_tensor.hpp"
 #include "detect/person_boxes.hpp"
@@ -90,6 +91,53 @@ CropVerdict judge_crop(const SinglePose& pose, const TopDownOptions& options) {
     v.posed = pose.presence >= options.min_pose_presence && v.passing >= 2;
   }
   return v;
+}
+
+namespace {
+
+// The points a posed person's boxes span, in frame pixels: BlazePose's landmarks whose presence
+// reaches box_landmark_presence when at least two do, else the keypoints scoring
+// min_keypoint_score. Returns how many, and whether they are landmarks.
+std::pair<std::size_t, bool> posed_points(const SinglePose& pose, const SquareRegion& region,
+                                          const TopDownOptions& options,
+                                          std::array<Keypoint2D, kBlazePoseBody>& points) {
+  const auto in_frame = [&](const std::array<float, 3>& point) {
+    const auto& [y, x, score] = point;
+    return Keypoint2D{region.cx - region.side / 2 + x * region.side,
+                      region.cy - region.side / 2 + y * region.side, score};
+  };
+  std::size_t count = 0;
+  if (options.box_landmark_presence <= 1.0f) {
+    const auto body = std::span(pose.body).first(static_cast<std::size_t>(pose.body_landmarks));
+    for (const auto& landmark : body)
+      if (landmark[2] >= options.box_landmark_presence) points[count++] = in_frame(landmark);
+    if (count >= 2) return {count, true};
+  }
+  // Fewer than two landmarks span no box: the kept keypoints' then (MoveNet's always).
+  count = 0;
+  for (const auto& keypoint : pose.keypoints)
+    if (keypoint[2] >= options.min_keypoint_score) points[count++] = in_frame(keypoint);
+  return {count, false};
+}
+
+}  // namespace
+
+Box2D posed_box(const SinglePose& pose, const SquareRegion& region, const TopDownOptions& options,
+                int frame_width, int frame_height) {
+  std::array<Keypoint2D, kBlazePoseBody> points{};
+  const auto [count, landmarks] = posed_points(pose, region, options, points);
+  const auto present = std::span(points).first(count);
+  if (landmarks && options.anatomical_landmark_box)
+    return clip_box(points_box(present, kLandmarkBoxMargins), static_cast<float>(frame_width),
+                    static_cast<float>(frame_height));
+  return keypoint_box(present, kHeadMargin);
+}
+
+Box2D posed_crop_box(const SinglePose& pose, const SquareRegion& region,
+                     const TopDownOptions& options) {
+  std::array<Keypoint2D, kBlazePoseBody> points{};
+  const auto [count, landmarks] = posed_points(pose, region, options, points);
+  return keypoint_box(std::span(points).first(count), kHeadMargin);
 }
 
 TopDownDetector::TopDownDetector(const TopDownOptions& options,
@@ -182,7 +230,7 @@ void TopDownDetector::add_crops(const ImageBuffer& frame, std::span<const Box2D>
   run_keypoints(first, count, copies);
   profile_.keypoints += seconds_since(start);
 }
-void TopDownDetector::people_found(std::vector<Found>& found) const {
+void TopDownDetector::people_found(const ImageBuffer& frame, std::vector<Found>& found) const {
   for (std::size_t i = 0; i < found_.size(); ++i) {
     const SquareRegion& r = regions_[i];
     MovenetPerson person;
@@ -200,8 +248,10 @@ void TopDownDetector::people_found(std::vector<Found>& found) const {
     const bool sure = options_.sure_box_score > 0 && box_score >= options_.sure_box_score;
     if (!posed && !sure) continue;
     // Keypoints too unsure to outline the person: the detector's box does.
-    person.box = posed ? keypoint_box(person.keypoints, kHeadMargin) : crop_boxes_[i];
-    found.push_back({person, 0, box_score, posed});
+    person.box =
+        posed ? posed_box(found_[i], r, options_, frame.width(), frame.height()) : crop_boxes_[i];
+    const Box2D follow = posed ? posed_crop_box(found_[i], r, options_) : crop_boxes_[i];
+    found.push_back({person, follow, 0, box_score, posed});
   }
 }
 
@@ -255,7 +305,7 @@ void TopDownDetector::carry(std::vector<Found>& out) {
       ++p;
     }
     person.box = moved(person.box, dx, dy);
-    out.push_back({person, f.carried + 1, f.box_score, true});
+    out.push_back({person, moved(f.box, dx, dy), f.carried + 1, f.box_score, true});
     carried_[i] = 1;
     ++profile_.carried;
   }
@@ -334,7 +384,7 @@ std::vector<MovenetPerson> TopDownDetector::detect(const ImageBuffer& frame) {
     }
   }
   add_crops(frame, std::span<const Box2D>(boxes).subspan(cropped), copies);
-  people_found(found);
+  people_found(frame, found);
   std::vector<MovenetPerson> people;
   std::vector<std::size_t> kept;  // per person: their index in `found`
   {
@@ -352,12 +402,13 @@ std::vector<MovenetPerson> TopDownDetector::detect(const ImageBuffer& frame) {
   std::vector<Followed> next;
   for (std::size_t i = 0; i < people.size(); ++i) {
     const MovenetPerson& p = people[i];
-    Followed f{p.box, 0, 0, p, found[kept[i]].carried, found[kept[i]].box_score};
-    const float cx = p.box.x + p.box.width / 2, cy = p.box.y + p.box.height / 2;
+    const Found& found_p = found[kept[i]];
+    Followed f{found_p.follow, 0, 0, p, found_p.carried, found_p.box_score};
+    const float cx = f.box.x + f.box.width / 2, cy = f.box.y + f.box.height / 2;
     float best = 0.3f;  // the predecessor must overlap the person this much
     for (const Followed& old : followed_) {
       const Box2D predicted = moved(old.box, old.vx, old.vy);
-      const float overlap = iou(predicted, p.box);
+      const float overlap = iou(predicted, f.box);
       if (overlap <= best) continue;
       best = overlap;
       // Smoothed: half the new displacement, half the old motion.

@@ -29,6 +29,7 @@
 #include "detect/keypoint_flow.hpp"
 #include "detect/movenet_decoder.hpp"
 #include "detect/ordered_workers.hpp"
+#include "detect/person_boxes.hpp"
 #include "detect/singlepose.hpp"
 
 namespace mocap::detect {
@@ -58,6 +59,16 @@ struct TopDownOptions {
   // this instead (MediaPipe's threshold on it, 0.5); the keypoints kept are still those scoring
   // min_keypoint_score.
   float min_pose_presence = 0.5f;
+  // Models with landmark presence (BlazePose): a posed person's box and their next crop span the
+  // body landmarks whose presence reaches this (MediaPipe's 0.5), hidden or blurred legs
+  // included, while the keypoints emitted are still those scoring min_keypoint_score. Above 1:
+  // the box of the emitted keypoints, as for MoveNet.
+  float box_landmark_presence = 0.5f;
+  // The margins of the person's landmark box: true, from the body's proportions, cut to the
+  // picture (posed_box); false, the keypoints' widening (12 % above, 6 % below and aside, not
+  // cut), kept to measure the two against each other. The crop's box is the latter either way
+  // (posed_crop_box).
+  bool anatomical_landmark_box = true;
   // A person the detector is sure of: a box scoring at least this is a person even when its
   // crop's keypoints fail the test above (blurred or crowded people); only the keypoints scoring
   // min_keypoint_score are kept, and the box is the detector's. Such a person is followed until
@@ -91,6 +102,31 @@ struct CropVerdict {
   bool posed = false;
 };
 CropVerdict judge_crop(const SinglePose& pose, const TopDownOptions& options);
+
+// The box of a posed person cut from `region` of a `frame_width` × `frame_height` picture, in
+// frame pixels. With BlazePose (and box_landmark_presence <= 1) that of the body landmarks whose
+// presence reaches box_landmark_presence, when at least two do, grown by kLandmarkBoxMargins (with
+// anatomical_landmark_box) and cut to the picture; otherwise that of the keypoints scoring
+// min_keypoint_score widened as keypoint_box does by 0.12 (the top of the head above the eyes).
+Box2D posed_box(const SinglePose& pose, const SquareRegion& region, const TopDownOptions& options,
+                int frame_width, int frame_height);
+
+// The box a posed person's next crop is cut around: that of the same points as posed_box's,
+// always widened by 0.12 as keypoint_box does and not cut to the picture. Wider than BlazePose's
+// person box on purpose: a crop cut tight to the last frame's landmarks loses the feet of a
+// moving person, their presence falls, and box and crop shrink frame after frame (measured in
+// docs/detection-strategies.md, "Boxes from the body's proportions").
+Box2D posed_crop_box(const SinglePose& pose, const SquareRegion& region,
+                     const TopDownOptions& options);
+
+// How far a person reaches beyond BlazePose's landmarks, as shares of the landmarks' extent (of a
+// standing person: eyes to soles). The feet's landmarks (heels, toes) lie on the soles: nothing
+// below. The top of the head lies 105-110 mm above the eyes at an eye height of 1505-1630 mm
+// (British women and men, 50th percentile, stature minus eye height in Pheasant's tables): 0.07.
+// Aside, the deltoids reach (465 - 400) / 2 = 32 mm beyond the acromia (bideltoid against
+// biacromial breadth, British men), the shoulder landmark sitting about as far inside them:
+// 0.03 (50 mm of 1630). Chosen from these tables before any run, not fitted.
+inline constexpr BoxMargins kLandmarkBoxMargins{0.07f, 0.0f, 0.03f};
 
 // Where the time of detect() went, summed over the frames since the detector was made (seconds,
 // wall clock). CenterNet runs on a helper thread when there are several workers, then overlapping
@@ -131,7 +167,7 @@ class TopDownDetector {
 
  private:
   struct Followed {
-    Box2D box;             // the person's box in the last frame
+    Box2D box;             // the box their next crop is cut around (posed_crop_box)
     float vx = 0, vy = 0;  // motion of the box centre per frame
     MovenetPerson person;  // their keypoints in the last frame
     int carried = 0;       // frames since their last keypoint pass
@@ -142,6 +178,7 @@ class TopDownDetector {
   // test (or the detector's score alone kept them).
   struct Found {
     MovenetPerson person;
+    Box2D follow;  // the box of their next crop
     int carried = 0;
     float box_score = 0;
     bool posed = true;
@@ -154,7 +191,7 @@ class TopDownDetector {
   // Keypoints of crops_[0, count) into found_[first, first + count), on `copies` copies at once.
   void run_keypoints(int first, int count, int copies);
   // People of the crops of this frame, appended to `found`.
-  void people_found(std::vector<Found>& found) const;
+  void people_found(const ImageBuffer& frame, std::vector<Found>& found) const;
   // The followed people due no keypoint pass moved into this frame by optical flow, appended to
   // `out`; marks in carried_ which were (the others need a crop).
   void carry(std::vector<Found>& out);

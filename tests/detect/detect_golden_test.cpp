@@ -210,6 +210,15 @@ void check_blazepose(SinglePoseModel model, const RunnerOptions& runtime,
       EXPECT_NEAR(y, want[l + 1].get<double>() / size, kLandmarkTolerance / size) << k;
       EXPECT_NEAR(score, 1.0 / (1.0 + std::exp(-want[l + 3].get<double>())), kScoreTolerance) << k;
     }
+    ASSERT_EQ(poses[n].body_landmarks, kBlazePoseBody);
+    for (int k = 0; k < kBlazePoseBody; ++k) {  // the body landmarks and their presence
+      const std::size_t l = static_cast<std::size_t>(k) * 5;
+      const auto& [y, x, presence] = poses[n].body[static_cast<std::size_t>(k)];
+      EXPECT_NEAR(x, want[l].get<double>() / size, kLandmarkTolerance / size) << k;
+      EXPECT_NEAR(y, want[l + 1].get<double>() / size, kLandmarkTolerance / size) << k;
+      EXPECT_NEAR(presence, 1.0 / (1.0 + std::exp(-want[l + 4].get<double>())), kScoreTolerance)
+          << k;
+    }
     std::cout << "  " << refs[n].at("id").get<std::string>() << ": landmarks max |diff| "
               << worst_xyz << " px, logits " << worst_logit << ", flag " << poses[n].presence
               << " (TF.js " << flag << ")\n";

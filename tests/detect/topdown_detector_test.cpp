@@ -190,6 +190,67 @@ TEST(TopDownDetector, APresenceFlagIsThePersonTestOfTheModelsThatHaveOne) {
   EXPECT_FALSE(judge_crop(pose, o).posed);
 }
 
+// BlazePose's person box (posed_box): the landmarks whose presence passes, blurred legs included,
+// while the keypoints emitted keep their visibility; MoveNet's, or too few present landmarks, the
+// kept keypoints'. Synthetic outputs of one 256-px crop, so that every number is known.
+TEST(TopDownDetector, ABlazePoseBoxReachesTheFeetItsLandmarksPlace) {
+  constexpr int kSize = 256;
+  GraphTensor landmarks{{1, kBlazePoseLandmarks * 5}, {}}, flag{{1, 1, 1, 1}, {0.9f}};
+  landmarks.values.assign(landmarks.size(), 0.0f);
+  const auto set = [&](int k, float x, float y, float visibility, float presence) {
+    float* l = landmarks.values.data() + k * 5;
+    l[0] = x, l[1] = y, l[3] = visibility, l[4] = presence;  // logits
+  };
+  // A standing person along x = 128 px, landmark k at y = 40 + 5 k (toes at 200); the legs from
+  // the knees down (25-32) are blurred (visibility σ(-3)) but present (σ(3)).
+  for (int k = 0; k < kBlazePoseBody; ++k) set(k, 128, 40 + 5.0f * k, k >= 25 ? -3 : 3, 3);
+  set(19, 250, 135, -3, -3);  // a hand outside the picture: not present, left out
+  set(20, 20, 140, -3, 3);    // a hand hidden but present: in the box, not a keypoint
+  const SinglePose pose = decode_blazepose(landmarks, flag, kSize, 0);
+  EXPECT_EQ(pose.body_landmarks, kBlazePoseBody);
+  EXPECT_NEAR(pose.body[32][2], 1 / (1 + std::exp(-3.0f)), 1e-6);
+  EXPECT_LT(pose.keypoints[15][2], 0.3f);  // the ankles keep their visibility: not emitted
+  EXPECT_GT(pose.keypoints[11][2], 0.3f);
+
+  const SquareRegion region{500, 300, kSize};  // crop pixel (x, y) is frame (372 + x, 172 + y)
+  const auto expect_box = [](const Box2D& got, Box2D want) {
+    EXPECT_NEAR(got.x, want.x, 1e-3);
+    EXPECT_NEAR(got.y, want.y, 1e-3);
+    EXPECT_NEAR(got.width, want.width, 1e-3);
+    EXPECT_NEAR(got.height, want.height, 1e-3);
+  };
+  TopDownOptions o;  // box_landmark_presence 0.5, anatomical_landmark_box
+  // The landmarks span x 392 (hand 20) to 500, y 212 (nose) to 372 (toes): 160 px tall. Grown by
+  // 0.07 of that above (11.2 px), 0.03 on each side (4.8 px), nothing below the toes.
+  expect_box(posed_box(pose, region, o, 1000, 1000), {387.2f, 200.8f, 117.6f, 171.2f});
+  // Cut to a 640 x 360 picture: the feet below its bottom edge are left out.
+  expect_box(posed_box(pose, region, o, 640, 360), {387.2f, 200.8f, 117.6f, 159.2f});
+  // The same person at the picture's top left corner (frame = crop - 28 px): x from -12.8 cut to 0.
+  expect_box(posed_box(pose, {100, 100, kSize}, o, 640, 360), {0, 0.8f, 104.8f, 171.2f});
+  // The next crop's box: the keypoints' widening, 0.12 × 160 above, half below and aside, not
+  // cut; with anatomical_landmark_box off the person's box too.
+  const Box2D widened{382.4f, 192.8f, 127.2f, 188.8f};
+  expect_box(posed_crop_box(pose, region, o), widened);
+  o.anatomical_landmark_box = false;
+  expect_box(posed_box(pose, region, o, 640, 360), widened);
+  o.anatomical_landmark_box = true;
+  // The kept keypoints, nose (212) to hips (24: 332), 120 px, widened as before: 14.4 px above,
+  // 7.2 below and aside, not cut.
+  const Box2D keypoints_box{492.8f, 197.6f, 14.4f, 141.6f};
+  o.box_landmark_presence = 2;  // off
+  expect_box(posed_box(pose, region, o, 640, 300), keypoints_box);
+  o.box_landmark_presence = 0.5f;
+  SinglePose one = pose;  // a single landmark present spans no box: the keypoints' again
+  for (auto& l : one.body) l[2] = 0.1f;
+  one.body[32][2] = 0.9f;
+  expect_box(posed_box(one, region, o, 640, 300), keypoints_box);
+  SinglePose movenet = pose;  // no landmarks: the keypoints'
+  movenet.body_landmarks = 0;
+  movenet.presence = kNoPresence;
+  expect_box(posed_box(movenet, region, o, 640, 300), keypoints_box);
+  expect_box(posed_crop_box(movenet, region, o), keypoints_box);
+}
+
 // BlazePose lite in the crops: the pedestrians of vtest frame 300, each with a presence flag of
 // at least MediaPipe's 0.5 as the person score, their keypoints confident ones only.
 TEST(TopDownDetector, BlazePoseFindsThePedestriansOfFrame300) {

@@ -7,6 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "detect/singlepose.hpp"
 #include "support/mocap_process.hpp"
 #include "support/models.hpp"
 #include "support/shared_data.hpp"
@@ -100,6 +101,26 @@ TEST_F(ReconstructVideoTest, AVideoBecomesPosesBvhAndAnOverlayVideo) {
   EXPECT_EQ(summary.at("frames"), 30);
   EXPECT_EQ(summary.at("fit"), "full");
   EXPECT_NE(run.out().find(out + "/overlay.mp4"), std::string::npos) << run.out();
+}
+
+// The BlazePose preset puts BlazePose full in the top-down node and finds the pedestrians.
+TEST_F(ReconstructVideoTest, TheBlazePosePresetFindsThePedestrians) {
+  try {
+    detect::cached_model_json(detect::model_name(detect::SinglePoseModel::blazepose_full));
+  } catch (const detect::ModelMissing&) {
+    GTEST_SKIP() << "BlazePose full absent: tools/setup.sh --models-only";
+  }
+  auto run = reconstruct("blaze", kVideo.string(),
+                         {"--detector", "topdown-blaze", "--fit", "off", "--set", "src.count=5"});
+  ASSERT_EQ(run.wait(300s), 0) << run.err();
+  const auto summary =
+      nlohmann::json::parse(test::read_file(dir_->file("blaze") + "/summary.json"));
+  EXPECT_EQ(summary.at("detector").at("type"), "detect.topdown");
+  EXPECT_EQ(summary.at("detector").at("params").at("pose_model"), "blazepose-full");
+  std::size_t people = 0;
+  for (const auto& line : test::read_lines(dir_->file("blaze") + "/poses.jsonl"))
+    people += nlohmann::json::parse(line).at("people").size();
+  EXPECT_GE(people, 5u * 3);  // 4-6 walkers in view on these frames
 }
 
 TEST_F(ReconstructVideoTest, AMissingModelNamesTheSetupCommand) {

@@ -100,13 +100,16 @@ Strategy make_strategy(const std::string& spec, detect::Backend backend, int thr
       o.pose_model = detect::parse_pose_model(parts[1]);
     } catch (const std::invalid_argument&) {
       throw std::invalid_argument(
-          "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:kEVERY][:uSURE] with "
+          "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:kEVERY][:uSURE][:"
+          "bPRESENCE][:m0] with "
           "MODEL " +
           std::string(detect::pose_model_names()) + ", got " + spec);
     }
     o.detect_every = std::stoi(parts[2]);
     // Then WORKERS and THREADS, and anywhere tN (person detector on N tiles; tNw: and the whole
-    // frame), sX (its score threshold), kK (keypoint pass every K frames) and uX (sure_box_score).
+    // frame), sX (its score threshold), kK (keypoint pass every K frames), uX (sure_box_score) and
+    // bX (box_landmark_presence), m0 (the landmark box widened as the keypoints', not cut to the
+    // picture: anatomical_landmark_box off).
     std::vector<std::string> numbers;
     for (std::size_t i = 3; i < parts.size(); ++i) {
       if (parts[i].size() > 1 && parts[i][0] == 't') {
@@ -116,6 +119,10 @@ Strategy make_strategy(const std::string& spec, detect::Backend backend, int thr
         o.sure_box_score = std::stof(parts[i].substr(1));
       else if (parts[i].size() > 1 && parts[i][0] == 's')
         o.min_box_score = std::stof(parts[i].substr(1));
+      else if (parts[i].size() > 1 && parts[i][0] == 'b')
+        o.box_landmark_presence = std::stof(parts[i].substr(1));
+      else if (parts[i] == "m0")
+        o.anatomical_landmark_box = false;
       else if (parts[i].size() > 1 && parts[i][0] == 'k')
         o.keypoint_every = std::stoi(parts[i].substr(1));
       else
@@ -123,7 +130,8 @@ Strategy make_strategy(const std::string& spec, detect::Backend backend, int thr
     }
     if (numbers.size() > 2)
       throw std::invalid_argument(
-          "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:kEVERY][:uSURE], got " +
+          "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:kEVERY][:uSURE][:"
+          "bPRESENCE][:m0], got " +
           spec);
     o.backend = backend;
     o.threads = numbers.size() == 2 ? std::stoi(numbers[1]) : threads;
@@ -135,10 +143,10 @@ Strategy make_strategy(const std::string& spec, detect::Backend backend, int thr
     return {spec, [d](const ImageBuffer& f) { return d->detect(f); }, [d] { d->reset(); },
             [d] { return d->profile(); }, o};
   }
-  throw std::invalid_argument(
-      "unknown strategy '" + spec +
-      "' (multipose:SIZE, tiles:CxR:TILE:FRAME, "
-      "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:kEVERY][:uSURE])");
+  throw std::invalid_argument("unknown strategy '" + spec +
+                              "' (multipose:SIZE, tiles:CxR:TILE:FRAME, "
+                              "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:"
+                              "kEVERY][:uSURE][:bPRESENCE][:m0])");
 }
 
 // Every frame of a video, or the one image of a still.
@@ -336,6 +344,7 @@ void diagnose(const std::string& input, const eval::DetectionTruth& truth, const
   std::map<std::string, int> causes;
   std::map<std::string, std::pair<int, int>> by_height;  // found, all
   std::array<int, 3> nearest{};                          // misses by nearest IoU bucket
+  std::array<int, 3> loose{};  // (d) by the nearest box's height: < 0.9, 0.9-1.1, > 1.1 x true
   int truths = 0;
   Frames frames(input);
   for (int i = 0;; ++i) {
@@ -369,8 +378,9 @@ void diagnose(const std::string& input, const eval::DetectionTruth& truth, const
         by_height[band].first++;
         continue;
       }
-      float near = 0;
-      for (const Box2D& b : found) near = std::max(near, detect::iou(b, box));
+      float near = 0, near_height = 0;
+      for (const Box2D& b : found)
+        if (const float v = detect::iou(b, box); v > near) near = v, near_height = b.height;
       nearest[near < 0.1f ? 0 : near < 0.3f ? 1 : 2]++;
       float best_score = -1, best_iou = 0.3f;    // the best proposal near the box
       const detect::Detection* above = nullptr;  // the nearest passing the threshold
@@ -382,6 +392,8 @@ void diagnose(const std::string& input, const eval::DetectionTruth& truth, const
       }
       if (near >= 0.3f) {
         causes["(d) found, box IoU 0.3-0.5"]++;
+        const float ratio = near_height / box.height;
+        loose[ratio < 0.9f ? 0 : ratio <= 1.1f ? 1 : 2]++;
       } else if (best_score < 0) {
         causes["(a) no proposal near it"]++;
       } else if (!above) {
@@ -423,8 +435,9 @@ void diagnose(const std::string& input, const eval::DetectionTruth& truth, const
               static_cast<double>(alone_matched) / std::max(1, alone_counted));
   std::printf(
       "\nMisses by the IoU of the nearest found person: < 0.1: %d, 0.1-0.3: %d, "
-      "0.3-0.5: %d\n\n| true height | recall |\n|---|---|\n",
-      nearest[0], nearest[1], nearest[2]);
+      "0.3-0.5: %d (its box's height < 0.9 x the true one: %d, 0.9-1.1: %d, > 1.1: %d)\n\n"
+      "| true height | recall |\n|---|---|\n",
+      nearest[0], nearest[1], nearest[2], loose[0], loose[1], loose[2]);
   for (const auto& [band, n] : by_height)
     std::printf("| %s | %d / %d |\n", band.c_str(), n.first, n.second);
   std::fflush(stdout);
@@ -476,11 +489,14 @@ int main(int argc, char** argv) {
               "multipose:SIZE, "
               "tiles:CxR:TILE:FRAME, "
               "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:kEVERY][:"
-              "uSURE] "
+              "uSURE][:bPRESENCE][:m0] "
               "(MODEL: lightning, thunder, blazepose-lite, blazepose-full, blazepose-heavy; "
               "workers: copies of the keypoint network sharing a frame's crops; tTILES: person "
               "detector tiles, tTILESw: and the whole frame, sSCORE: its box score floor, uSURE: "
-              "boxes scoring SURE are people whatever their keypoints, kEVERY: keypoint pass every "
+              "boxes scoring SURE are people whatever their keypoints, bPRESENCE: BlazePose "
+              "boxes from the landmarks of this presence (default 0.5; above 1: from the kept "
+              "keypoints), m0: that landmark box widened as the keypoints' and not cut to the "
+              "picture (before the anatomical margins), kEVERY: keypoint pass every "
               "EVERY "
               "frames, optical flow between; a top-down "
               "strategy also prints where its time went)",

@@ -30,6 +30,11 @@ const std::vector<DetectorPreset>& detector_presets() {
        "detect.topdown",
        {{"pose_model", "thunder"}, {"detect_every", "10"}},
        "the same with MoveNet Thunder (256 px crops): better keypoints, slower"},
+      {"topdown-blaze",
+       "detect.topdown",
+       {{"pose_model", "blazepose-full"}, {"detect_every", "10"}},
+       "the same with BlazePose full (256 px crops, 33 landmarks, the pose flag as the person "
+       "test): more people found (docs/detection-strategies.md), slower per crop"},
       {"topdown-tiles",
        "detect.topdown",
        {{"pose_model", "lightning"},

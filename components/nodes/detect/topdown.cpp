@@ -48,6 +48,10 @@ class TopDownNode : public Node {
                     "BlazePose: a crop whose pose-presence flag is below shows nobody "
                     "(MediaPipe's threshold)",
                     {0.0, 1.0});
+    c.param<double>("box_landmark_presence", 0.5,
+                    "BlazePose: a person's box spans the landmarks of at least this presence "
+                    "(hidden legs included; MediaPipe's 0.5); above 1: the kept keypoints'",
+                    {0.0, 2.0});
     c.param<double>("min_person_score", 0.35,
                     "a crop whose passing keypoints score less on average shows nobody",
                     {0.0, 1.0});
@@ -77,6 +81,7 @@ class TopDownNode : public Node {
     const std::string model = ctx.param<std::string>("pose_model");
     o.pose_model = detect::parse_pose_model(model);
     o.min_pose_presence = ctx.param<float>("min_pose_presence");
+    o.box_landmark_presence = ctx.param<float>("box_landmark_presence");
     o.detect_every = ctx.param<int>("detect_every");
     o.min_box_score = ctx.param<float>("min_box_score");
     o.detector_tiles = ctx.param<int>("detector_tiles");
