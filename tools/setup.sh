@@ -54,6 +54,9 @@ packages=(
   libtinygltf-dev                                       # glTF 2.0 export (sink.gltf, mocap export)
   liblo-dev liblo-tools                                 # OSC for the VMC live link (sink.vmc); oscdump in its tests
   chromium                                              # a real browser for the viewer's tests (headless)
+  python3-gi gir1.2-gst-rtsp-server-1.0                # a real RTSP server for the network-camera tests
+  gstreamer1.0-plugins-base gstreamer1.0-plugins-good   #   (tests/support/rtsp_server.py): RTP payloaders,
+  gstreamer1.0-plugins-ugly gstreamer1.0-libav          #   x264enc, decoders of the videos it serves
 )
 
 # npm fetches the detector model; a Node.js from elsewhere (e.g. NodeSource) brings its own npm.

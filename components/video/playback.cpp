@@ -24,7 +24,8 @@ Playback::Playback(std::string path, SourceOptions source_options, PlaybackOptio
       live_(options.live.value_or(source_.live())),
       paced_(live_ && !source_.live()),
       loop_(options.loop && !source_.live()),
-      frame_offset_(options.frame_offset) {}
+      frame_offset_(options.frame_offset),
+      reconnect_ms_(options.reconnect_ms) {}
 
 std::string Playback::describe() const {
   std::ostringstream text;
@@ -45,6 +46,9 @@ std::string Playback::describe_losses() const {
   std::string text = std::to_string(late_) + " skipped (late), " + std::to_string(undecodable_) +
                      " corrupt frames skipped";
   if (loop_) text += ", started again " + std::to_string(passes_) + " times";
+  if (losses_ > 0)
+    text += ", stream lost " + std::to_string(losses_) + " times, back " +
+            std::to_string(reconnects_) + " times";
   return text;
 }
 
@@ -53,9 +57,11 @@ double Playback::frame_period_s() const {
 }
 
 std::optional<StampedFrame> Playback::next(const WaitUntil& wait) {
+  if (reconnecting() && !reconnect(wait)) return std::nullopt;
   for (;;) {
     std::optional<Frame> frame = paced_ ? paced_read(wait) : source_.read();
     if (frame) {
+      frame->index += index_base_;
       last_media_time_s_ = frame->media_time_s;
       std::int64_t stamp =
           live_ ? frame->capture_ns : std::llround((pass_offset_s_ + frame->media_time_s) * 1e9);
@@ -66,6 +72,10 @@ std::optional<StampedFrame> Playback::next(const WaitUntil& wait) {
       return StampedFrame{std::move(*frame), stamp};
     }
     if (stopped_) return std::nullopt;  // a paced wait cut short: not the end
+    if (may_reconnect()) {
+      lose_stream();
+      return std::nullopt;
+    }
     undecodable_ +=
         static_cast<std::uint64_t>(std::max<std::int64_t>(0, source_.frames_undecodable()));
     if (!start_next_pass()) return std::nullopt;
@@ -80,6 +90,50 @@ bool Playback::start_next_pass() {
   ++passes_;
   return true;
 }
+
+// A live stream of no announced length has no end: its stop is a loss.
+bool Playback::may_reconnect() const {
+  return live_ && reconnect_ms_ > 0 && source_.kind() == SourceKind::network &&
+         source_.frame_count() < 0;
+}
+
+void Playback::lose_stream() {
+  const std::int64_t now = realtime_now_ns();
+  lost_since_ns_ = now;
+  next_attempt_ns_ = now;  // at once: a server restarted answers right away
+  attempts_ = 0;
+  ++losses_;
+  index_base_ += source_.frames_read();
+  news_ += "lost " + path_ + " after " + std::to_string(index_base_) +
+           " frames (the server went away, the network is down, or the stream ended); opening it "
+           "again every " +
+           std::to_string(reconnect_ms_) + " ms until it answers";
+}
+
+bool Playback::reconnect(const WaitUntil& wait) {
+  if (next_attempt_ns_ > realtime_now_ns() && !wait(next_attempt_ns_)) {
+    stopped_ = true;
+    return false;
+  }
+  ++attempts_;
+  next_attempt_ns_ = realtime_now_ns() + std::int64_t{reconnect_ms_} * 1'000'000;
+  try {
+    source_ = VideoSource(path_, source_options_);
+  } catch (const std::exception&) {
+    return false;  // not back yet (the reason was given when it was lost)
+  }
+  const double away_s = static_cast<double>(realtime_now_ns() - lost_since_ns_) * 1e-9;
+  std::ostringstream text;
+  text.precision(3);
+  text << path_ << " is back after " << away_s << " s (" << attempts_ << " attempts)";
+  if (!news_.empty()) news_ += "; ";
+  news_ += text.str();
+  lost_since_ns_ = 0;
+  ++reconnects_;
+  return true;
+}
+
+std::string Playback::take_news() { return std::exchange(news_, std::string()); }
 
 std::optional<Frame> Playback::paced_read(const WaitUntil& wait) {
   if (pace_start_ns_ == 0) pace_start_ns_ = realtime_now_ns();

@@ -10,6 +10,12 @@
 // with their capture time. Offline, a frame is stamped with its time in the source (from 0) plus
 // the length of the passes before it, so that outputs say where in the video they are. A frame
 // offset shifts indices and stamps alike (PlaybackOptions::frame_offset).
+//
+// A network stream read live that stops (the server went away, the network is down, or the server
+// ended a stream that announced no length: a camera has no end) is lost, not ended: it is opened
+// again every reconnect interval until it answers, and its frames go on with the next indices
+// (PlaybackOptions::reconnect_ms). A stream that announced its length (a file served over HTTP or
+// RTSP) ends at its end.
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -27,6 +33,9 @@ struct PlaybackOptions {
   // Added to every frame's index, and its period times this to every stamp: this source's frame i
   // is the scene's frame i + frame_offset (views filmed without a common clock).
   std::int64_t frame_offset = 0;
+  // Network streams read live: a stream that stops is opened again this often until it answers;
+  // 0: its stop is its end.
+  int reconnect_ms = 1000;
 };
 
 struct StampedFrame {
@@ -42,9 +51,13 @@ class Playback {
   // Opens the source (throws InputError naming it, as VideoSource does).
   Playback(std::string path, SourceOptions source_options, PlaybackOptions options);
 
-  // The next frame; nullopt at the end of the last pass, or when `wait` was cut short. Errors of
-  // the source (a truncated file, a camera unplugged) are thrown as VideoSource throws them.
+  // The next frame; nullopt at the end of the last pass, when `wait` was cut short (stopped()),
+  // or while a lost stream is not back (reconnecting(): call again, it waits for the next
+  // attempt). Errors of the source (a truncated file, a camera unplugged) are thrown as
+  // VideoSource throws them.
   std::optional<StampedFrame> next(const WaitUntil& wait);
+  // What happened to a stream since the last call, for logs (lost, back): empty when nothing.
+  std::string take_news();
 
   const VideoSource& source() const { return source_; }
   // For logs: "file PATH, WxH, F fps, N frames, offline", with a note when an option asked for
@@ -58,11 +71,17 @@ class Playback {
   // Frames the container announced that FFmpeg could not decode, over the passes finished.
   std::uint64_t undecodable_frames() const { return undecodable_; }
   std::uint64_t passes_started_again() const { return passes_; }
-  bool stopped() const { return stopped_; }  // a paced wait was cut short
+  bool stopped() const { return stopped_; }                  // a paced wait was cut short
+  bool reconnecting() const { return lost_since_ns_ != 0; }  // a lost stream, not back yet
+  std::uint64_t reconnects() const { return reconnects_; }   // times a lost stream came back
+  std::uint64_t losses() const { return losses_; }           // times a stream was lost
 
  private:
   std::optional<Frame> paced_read(const WaitUntil& wait);
   bool start_next_pass();  // false when the source is not looped or had no frame
+  bool may_reconnect() const;
+  void lose_stream();
+  bool reconnect(const WaitUntil& wait);  // false while the stream is not back (or stopped)
   double frame_period_s() const;
 
   std::string path_;
@@ -73,6 +92,11 @@ class Playback {
   std::int64_t pace_start_ns_ = 0;  // when the pass's first frame was due (0: not yet)
   double pass_offset_s_ = 0.0, last_media_time_s_ = 0.0;
   std::uint64_t late_ = 0, undecodable_ = 0, passes_ = 0;
+  int reconnect_ms_ = 0;
+  std::int64_t lost_since_ns_ = 0, next_attempt_ns_ = 0;  // while a stream is lost
+  std::int64_t index_base_ = 0;  // frames of the connections before this one
+  std::uint64_t reconnects_ = 0, losses_ = 0, attempts_ = 0;
+  std::string news_;
 };
 
 }  // namespace mocap::video

@@ -40,7 +40,8 @@ struct SourceOptions {
   // Camera devices: the mode asked for (0: the device's current one).
   int width = 0, height = 0;
   double fps = 0.0;
-  // Network streams: how long opening and each read may take.
+  // Network streams: how long opening and each read may take. Opening includes FFmpeg's look at
+  // the stream (about 33 frames of an RTSP H.264 camera: 3.3 s at 10 fps), so keep it longer.
   int timeout_ms = 10000;
 };
 
@@ -60,7 +61,9 @@ class VideoSource {
   VideoSource(VideoSource&&) noexcept;
   VideoSource& operator=(VideoSource&&) noexcept;
 
-  // The next frame; nullopt at the end of a file, folder or network stream. Throws InputError
+  // The next frame; nullopt at the end of a file, folder or network stream (a live stream whose
+  // server closed it, went away or stopped sending for timeout_ms: the frames FFmpeg still held
+  // come first; video::Playback reopens a live stream). Throws InputError
   // when a file, or a file served over a network stream, ends well before the frames its
   // container announces (truncated, connection lost), an image
   // of a folder cannot be read, or a camera device stops delivering (unplugged).

@@ -401,6 +401,16 @@ json offsets_json(const View& v) {
   return o;
 }
 
+// A live view: the frames its source delivered and its last state (a camera lost and not back
+// says "lost, reconnecting"), so that the summary names a camera that stopped mid-run.
+void add_camera_state(json& entry, const graph::GraphStats& stats, const std::string& node) {
+  for (const graph::NodeStats& n : stats.nodes) {
+    if (n.node != node) continue;
+    entry["frames_received"] = n.out;
+    entry["state"] = n.status.empty() ? "streaming" : n.status;
+  }
+}
+
 }  // namespace
 
 bool asks_for_multiview(int argc, char** argv) {
@@ -548,12 +558,15 @@ int reconstruct_multiview_command(int argc, char** argv) {
   json summary = summarize_output(out / "poses.jsonl");
   summary["calibration"] = rig_file;
   json view_list = json::array();
-  for (const View& v : views) {
-    view_list.push_back({{"camera", v.camera->name},
-                         {"path", v.path},
-                         {"kind", kind_name(v)},
-                         {"frames", v.frames},
-                         {"offset", offsets_json(v)}});
+  for (std::size_t i = 0; i < views.size(); ++i) {
+    const View& v = views[i];
+    json entry = {{"camera", v.camera->name},
+                  {"path", v.path},
+                  {"kind", kind_name(v)},
+                  {"frames", v.frames},
+                  {"offset", offsets_json(v)}};
+    if (live) add_camera_state(entry, run.result.stats, "view_" + std::to_string(i));
+    view_list.push_back(std::move(entry));
   }
   summary["views"] = view_list;
   summary["fps"] = fps;

@@ -5,6 +5,9 @@
 // newest frame. Late and damaged frames (FFmpeg could not decode them) are this node's drops.
 // A file, or a file served over HTTP/RTSP, that stops well before the frames its container
 // announces stops the graph with an error naming the input (the run ends incomplete, exit 1).
+// A live stream (a network camera) that stops is lost, not ended: logged naming the camera and
+// shown as the node's status, then opened again every reconnect_ms until it answers; the graph
+// keeps running (the other cameras of a rig go on).
 
 #include <iostream>
 #include <optional>
@@ -34,6 +37,10 @@ class VideoSourceNode : public Node {
     c.param<int>("height", 0, "devices: frame height to ask for (0: the device's)", {0, 16384});
     c.param<std::int64_t>("count", 0, "frames to send at most (0: all)", {0, 1e12});
     c.param<int>("timeout_ms", 10000, "network streams: open and read timeout", {100, 600000});
+    c.param<int>("reconnect_ms", 1000,
+                 "live network streams of no announced length: a stream that stops is opened "
+                 "again this often until it answers (0: its stop ends this source)",
+                 {0, 3600000});
     c.param<std::string>("camera", std::string(kDefaultCamera),
                          "the camera's name in the messages (as in the rig file, docs/cameras.md)");
     c.param<std::string>("stream", "", "stream id of the messages (default: the path)");
@@ -56,7 +63,8 @@ class VideoSourceNode : public Node {
     const auto mode = ctx.param<std::string>("mode");  // a choice: checked before open()
     video::PlaybackOptions playback{.live = {},
                                     .loop = ctx.param<bool>("loop"),
-                                    .frame_offset = ctx.param<std::int64_t>("frame_offset")};
+                                    .frame_offset = ctx.param<std::int64_t>("frame_offset"),
+                                    .reconnect_ms = ctx.param<int>("reconnect_ms")};
     if (mode != "auto") playback.live = mode == "live";
     playback_.emplace(path, options, playback);
     count_ = ctx.param<std::uint64_t>("count");
@@ -72,8 +80,12 @@ class VideoSourceNode : public Node {
       return ctx.sleep_for(std::chrono::nanoseconds(due_ns - realtime_ns()));
     });
     report_losses(ctx);
+    if (const std::string news = playback_->take_news(); !news.empty()) {
+      std::cerr << ctx.node_name() << " (camera " << camera_ << "): " << news << "\n";
+      ctx.report_status(playback_->reconnecting() ? "lost, reconnecting" : "reconnected");
+    }
     if (!frame) {
-      if (!playback_->stopped()) ctx.finish();
+      if (!playback_->stopped() && !playback_->reconnecting()) ctx.finish();
       return;
     }
     VideoFrame message;
