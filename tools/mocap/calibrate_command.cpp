@@ -622,10 +622,12 @@ int rig_people_command(int argc, char** argv) {
                         : layout == "BODY_25B" ? io::Body25Choice::body25b
                                                : io::Body25Choice::body25;
   std::vector<camera::BodySequence> sequences;
-  for (const PeopleView& v : views) {
+  for (std::size_t i = 0; i < views.size(); ++i) {
+    const PeopleView& v = views[i];
     const io::OpenPoseSequence json = io::read_openpose_folder(v.json, json_options);
     for (const io::FrameProblem& p : json.problems)
       std::cerr << "mocap calibrate rig: " << v.json.string() << ": " << p.message << "\n";
+    check_keypoints_fit(v, json, cameras[i]);
     sequences.push_back(camera::body_sequence(json.frames));
     if (view_options.max_frames && sequences.back().size() > std::size_t(*view_options.max_frames))
       sequences.back().resize(static_cast<std::size_t>(*view_options.max_frames));
