@@ -54,7 +54,7 @@ Pose pose(const Block6& b) { return {{b[0], b[1], b[2]}, {b[3], b[4], b[5]}}; }
 // pixel seen.
 template <typename T>
 void reproject(const T* k, const T* camera, const T* world, const std::array<double, 2>& pixel,
-               T* residual) {
+               T* residual, bool square_pixels = false) {
   T local[3];
   ceres::AngleAxisRotatePoint(camera, world, local);
   for (int i = 0; i < 3; ++i) local[i] += camera[3 + i];
@@ -65,13 +65,14 @@ void reproject(const T* k, const T* camera, const T* world, const std::array<dou
   const T xd = x * radial + T(2) * k[6] * x * y + k[7] * (r2 + T(2) * x * x);
   const T yd = y * radial + k[6] * (r2 + T(2) * y * y) + T(2) * k[7] * x * y;
   residual[0] = k[0] * xd + k[2] - T(pixel[0]);
-  residual[1] = k[1] * yd + k[3] - T(pixel[1]);
+  residual[1] = (square_pixels ? k[0] : k[1]) * yd + k[3] - T(pixel[1]);
 }
 
 // A board corner: board frame -> world -> image.
 struct Reprojection {
   std::array<double, 3> object;
   std::array<double, 2> pixel;
+  bool square_pixels = false;  // fy is fx
 
   template <typename T>
   bool operator()(const T* k, const T* camera, const T* board, T* residual) const {
@@ -79,7 +80,7 @@ struct Reprojection {
     T world[3];
     ceres::AngleAxisRotatePoint(board, point, world);
     for (int i = 0; i < 3; ++i) world[i] += board[3 + i];
-    reproject(k, camera, world, pixel, residual);
+    reproject(k, camera, world, pixel, residual, square_pixels);
     return true;
   }
 };
@@ -116,6 +117,9 @@ struct LinkResidual {
 void bundle_adjust(BundleProblem& problem, std::vector<double>& errors) {
   std::vector<IntrinsicBlock> intrinsics;
   for (const Camera& c : problem.cameras) intrinsics.push_back(intrinsic_block(c));
+  const bool square = problem.refine_intrinsics && problem.square_pixels;
+  if (square)
+    for (IntrinsicBlock& b : intrinsics) b[0] = b[1] = 0.5 * (b[0] + b[1]);
   std::vector<Block6> cameras, boards;
   for (const Pose& p : problem.camera_poses) cameras.push_back(block(p));
   for (const Pose& p : problem.board_poses) boards.push_back(block(p));
@@ -131,7 +135,7 @@ void bundle_adjust(BundleProblem& problem, std::vector<double>& errors) {
   for (const CornerObservation& o : problem.corners) {
     if (!o.active) continue;
     auto* cost = new ceres::AutoDiffCostFunction<Reprojection, 2, kIntrinsics, 6, 6>(
-        new Reprojection{o.object_m, o.pixel});
+        new Reprojection{o.object_m, o.pixel, square});
     solver.AddResidualBlock(cost, loss, intrinsics[o.camera].data(), cameras[o.camera].data(),
                             boards[o.frame].data());
   }
@@ -157,9 +161,13 @@ void bundle_adjust(BundleProblem& problem, std::vector<double>& errors) {
     if (!solver.HasParameterBlock(intrinsics[c].data())) continue;
     if (problem.refine_intrinsics) {
       // k3 and k4 k5 k6 (the rational model's denominator) stay as given: fitted from a board
-      // that fills little of each image they trade against the focal length.
-      solver.SetManifold(intrinsics[c].data(),
-                         new ceres::SubsetManifold(kIntrinsics, {8, 9, 10, 11}));
+      // that fills little of each image they trade against the focal length. p1 p2 too unless
+      // asked for (rig_calibration.hpp, RigBoardOptions::tangential_distortion): a decentred lens
+      // looks like a shifted principal point, which looks like a turned camera.
+      std::vector<int> held{8, 9, 10, 11};
+      if (!problem.refine_tangential) held.insert(held.begin(), {6, 7});
+      if (square) held.insert(held.begin(), 1);  // fy: unused, fx serves both
+      solver.SetManifold(intrinsics[c].data(), new ceres::SubsetManifold(kIntrinsics, held));
     } else {
       solver.SetParameterBlockConstant(intrinsics[c].data());
     }
@@ -182,7 +190,9 @@ void bundle_adjust(BundleProblem& problem, std::vector<double>& errors) {
 
   for (std::size_t c = 0; c < cameras.size(); ++c) {
     problem.camera_poses[c] = pose(cameras[c]);
-    if (problem.refine_intrinsics) store_intrinsics(intrinsics[c], problem.cameras[c]);
+    if (!problem.refine_intrinsics) continue;
+    if (square) intrinsics[c][1] = intrinsics[c][0];
+    store_intrinsics(intrinsics[c], problem.cameras[c]);
   }
   for (std::size_t b = 0; b < boards.size(); ++b) problem.board_poses[b] = pose(boards[b]);
 
@@ -192,8 +202,8 @@ void bundle_adjust(BundleProblem& problem, std::vector<double>& errors) {
     const CornerObservation& o = problem.corners[i];
     if (!o.active) continue;
     double r[2];
-    Reprojection{o.object_m, o.pixel}(intrinsics[o.camera].data(), cameras[o.camera].data(),
-                                      boards[o.frame].data(), r);
+    Reprojection{o.object_m, o.pixel, square}(intrinsics[o.camera].data(), cameras[o.camera].data(),
+                                              boards[o.frame].data(), r);
     errors[i] = std::hypot(r[0], r[1]);
   }
   for (std::size_t i = 0; i < problem.sightings.size(); ++i) {

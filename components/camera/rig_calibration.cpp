@@ -239,11 +239,15 @@ Camera intrinsics_from_views(const CameraBoardViews& view, const RigBoardOptions
     object.push_back(object_points_m(b));
     pixels.push_back(image_points(b));
   }
-  cv::Mat K, D, rvecs, tvecs;
   // k3 held at zero, as OpenCV advises for ordinary lenses: a board far from the camera fills
-  // little of the image, and a free k3 trades against the focal length.
+  // little of the image, and a free k3 trades against the focal length. p1 p2 held at zero too
+  // unless asked for (RigBoardOptions::tangential_distortion).
+  int flags = cv::CALIB_FIX_K3;
+  if (!options.tangential_distortion) flags |= cv::CALIB_ZERO_TANGENT_DIST;
+  cv::Mat K = cv::Mat::eye(3, 3, CV_64F), D, rvecs, tvecs;
+  if (options.square_pixels) flags |= cv::CALIB_FIX_ASPECT_RATIO;  // fx / fy of K: 1
   rms = cv::calibrateCamera(object, pixels, cv::Size(view.width, view.height), K, D, rvecs, tvecs,
-                            cv::CALIB_FIX_K3);
+                            flags);
   Camera c;
   c.name = view.name;
   c.width = view.width;
@@ -492,6 +496,8 @@ RigCalibration calibrate_rig(const std::vector<CameraBoardViews>& all_views,
   }
   problem.fixed_camera = kept_position[graph.root];
   problem.refine_intrinsics = options.refine_intrinsics;
+  problem.refine_tangential = options.tangential_distortion;
+  problem.square_pixels = options.square_pixels && !options.intrinsics;
 
   std::vector<double> errors;
   for (int round = 0; round <= options.outlier_rounds; ++round) {

@@ -51,8 +51,21 @@ struct RigBoardOptions {
   std::optional<Rig> intrinsics;
   std::string intrinsics_source = "the intrinsics rig";  // its file, for messages
   int min_intrinsic_views = 4;
-  bool refine_intrinsics = false;  // also adjust fx fy cx cy k1 k2 p1 p2 in the bundle
-  double outlier_factor = 3.0;     // drop observations with error > factor x median, re-solve
+  // Also adjust fx fy cx cy k1 k2 (p1 p2) in the bundle (`mocap calibrate rig` always does for
+  // intrinsics from the cameras' own frames).
+  bool refine_intrinsics = false;
+  // Tangential distortion (p1 p2): fitted in a camera's own intrinsics and refined in the
+  // bundle, or (false) held: at zero in intrinsics from the camera's own frames, at their given
+  // value with `intrinsics`. Held by default: on a board 2-3 m away, filling little of each
+  // image, p1 p2 trade against the principal point, and it against the camera's rotation
+  // (mocap-bench-rig-board: worst angle 0.26-0.37 degrees with them fitted, 0.10-0.15 held;
+  // docs/cameras.md).
+  bool tangential_distortion = false;
+  // Intrinsics from the cameras' own frames with square pixels (fx = fy, as digital sensors
+  // have): one focal length less to trade against each camera's distance. false: fx and fy
+  // apart. Given intrinsics keep their fx and fy.
+  bool square_pixels = true;
+  double outlier_factor = 3.0;  // drop observations with error > factor x median, re-solve
   int outlier_rounds = 2;
   // The frame in which the board lies flat on the floor; -1: the first frame in which any
   // camera of the rig sees the board.
@@ -156,6 +169,8 @@ struct BundleProblem {
   double loss_px = 1.0;          // Huber: past this an error grows linearly
   std::size_t fixed_camera = 0;  // its pose is held (the gauge)
   bool refine_intrinsics = false;
+  bool refine_tangential = false;  // with refine_intrinsics: p1 p2 too
+  bool square_pixels = false;      // with refine_intrinsics: one focal length, fx = fy
 };
 
 // Solves in place (Ceres, rig_bundle_adjustment.cpp); returns the reprojection error (px) of each

@@ -29,6 +29,9 @@ struct VirtualRoom {
   double hfov_deg = 70.0;
   double ring_radius_m = 2.2;  // cameras stand 2.0 .. 2.6 m from the centre (a 4 m room)
   unsigned seed = 1;
+  // Each camera's principal point off the image centre by up to this much (px, uniform in x and
+  // y, from a generator of its own: the scene is the same with any value); 0: centred.
+  double principal_offset_px = 0.0;
   camera::BoardSpec board{camera::BoardKind::charuco, 6, 4, 150.0, 110.0, "DICT_4X4_50"};
 };
 
@@ -53,6 +56,7 @@ inline VirtualRig make_virtual_rig(const VirtualRoom& room) {
   std::mt19937 rng(room.seed);
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
   VirtualRig rig;
+  std::mt19937 offset_rng(room.seed + 1);
   const double pi = std::acos(-1.0);
   for (int k = 0; k < room.cameras; ++k) {
     const double angle = 2 * pi * k / room.cameras + 0.15 * unit(rng);
@@ -64,6 +68,8 @@ inline VirtualRig make_virtual_rig(const VirtualRoom& room) {
         camera::Camera::from_fov(room.width, room.height, room.hfov_deg,
                                  "cam_" + std::string(k < 9 ? "0" : "") + std::to_string(k + 1));
     c.set_pose_from_centre(look_at(centre, target), centre);
+    c.cx += room.principal_offset_px * unit(offset_rng);
+    c.cy += room.principal_offset_px * unit(offset_rng);
     rig.cameras.push_back(c);
   }
   const double w = room.board.columns * room.board.square_mm / 1000.0;

@@ -109,5 +109,48 @@ TEST(CalibrateRigCommand, FromPeopleRefusesOnePersonStandingStill) {
       << bare.err();
 }
 
+// From people, OpenPose JSON views (no image size of their own) against the cameras' sizes:
+// Pose2Sim's balancing trial (portrait 1088x1920 cameras) with the intrinsics' width and height
+// swapped, or --size given landscape, is refused naming the camera and a file. At the right size
+// the check passes: FromPeopleRefusesOnePersonStandingStill gets past it to its own refusal.
+TEST(CalibrateRigCommand, FromPeopleRefusesKeypointsOutsideTheCamerasImage) {
+  MOCAP_REQUIRE_SHARED("eval/pose2sim_demo/S00_P00_T01_BalancingTrial/pose/cam01_json");
+  const auto demo = test::shared_data() / "eval" / "pose2sim_demo";
+  test::TempDir dir;
+  camera::Rig swapped = camera::read_rig(demo / "calibration" / "Calib_qualisys.toml");
+  for (camera::Camera& c : swapped.cameras) {
+    std::swap(c.width, c.height);
+    std::swap(c.cx, c.cy);
+    std::swap(c.fx, c.fy);
+  }
+  camera::write_rig(dir.file("landscape.toml"), swapped);
+  std::vector<std::string> views;
+  for (int k = 1; k <= 4; ++k)
+    views.push_back(
+        (demo / "S00_P00_T01_BalancingTrial" / "pose" / ("cam0" + std::to_string(k) + "_json"))
+            .string());
+  const auto command = [&](std::vector<std::string> head) {
+    head.insert(head.end(), views.begin(), views.end());
+    head.emplace_back("--out");
+    head.push_back(dir.file("rig.toml"));
+    return head;
+  };
+  test::Mocap wrong(
+      dir, "wrong",
+      command({"calibrate", "rig", "--from-people", "--intrinsics", dir.file("landscape.toml")}));
+  EXPECT_NE(wrong.wait(60s), 0);
+  EXPECT_NE(wrong.err().find("camera 'cam_01' is 1920x1088 but"), std::string::npos) << wrong.err();
+  EXPECT_NE(wrong.err().find("cam01_json/cam01.00"), std::string::npos) << wrong.err();
+  EXPECT_NE(wrong.err().find("give the views in the cameras' order"), std::string::npos)
+      << wrong.err();
+  EXPECT_FALSE(std::filesystem::exists(dir.file("rig.toml")));
+
+  test::Mocap size(
+      dir, "size",
+      command({"calibrate", "rig", "--from-people", "--hfov", "50", "--size", "1920x1088"}));
+  EXPECT_NE(size.wait(60s), 0);
+  EXPECT_NE(size.err().find("camera 'cam_01' is 1920x1088"), std::string::npos) << size.err();
+}
+
 }  // namespace
 }  // namespace mocap

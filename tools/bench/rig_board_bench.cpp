@@ -3,8 +3,12 @@
 // (tests/support/virtual_rig.hpp: blur and noise, frame 0 the board flat on the floor). Prints, per
 // camera, the position (mm) and angle (degrees) errors against the truth, the RMS reprojection
 // error, the corners found against their true pixels; then the same after the best rigid alignment
-// to the truth (what the bundle adjustment got wrong, without the floor board's pose); then a
-// camera that shares no frame.
+// to the truth (what the bundle adjustment got wrong, without the floor board's pose), the
+// principal point's error, and each camera's angle once the rotation common to all (the floor
+// board's) is taken out; for intrinsics given, held, refined with p1 p2 fitted and refined with p1
+// p2 held. Then a camera that shares no frame. --principal-offset moves the virtual cameras'
+// principal points off the image centre (the estimate starts at the centre only in the bundle's
+// first guess from cv::calibrateCamera, which fits it).
 
 #include <algorithm>
 #include <chrono>
@@ -81,17 +85,37 @@ struct Worst {
   double max_mm = 0, max_deg = 0;
 };
 
+// How the intrinsics are had: given (the truth), or from each camera's own frames, held as
+// calibrated or refined in the bundle, p1 p2 fitted or held at zero, fx and fy apart or one
+// (before 2026-11-26 the command's only way was p1 p2 fitted, fx and fy apart).
+struct Mode {
+  const char* what;
+  bool given, refine, tangential, square;
+};
+constexpr Mode kModes[] = {
+    {"given (the truth)", true, false, false, false},
+    {"from each camera's own frames, held (p1 p2 fitted, fx fy apart)", false, false, true, false},
+    {"from each camera's own frames, refined in the bundle, p1 p2 fitted, fx fy apart (before)",
+     false, true, true, false},
+    {"from each camera's own frames, refined in the bundle, p1 p2 held at 0, fx fy apart", false,
+     true, false, false},
+    {"from each camera's own frames, refined in the bundle, p1 p2 held at 0, fx = fy (now the "
+     "default)",
+     false, true, false, true},
+};
+
 void report(const test::VirtualRig& truth, const std::vector<CameraBoardViews>& views,
-            bool given_intrinsics, bool refine, const RigBoardOptions& search);
+            const Mode& mode, const RigBoardOptions& search);
 
 // One scene, rendered and searched once, calibrated three ways.
-void run(int cameras, int frames, int width, int height, unsigned seed, bool quick) {
+void run(int cameras, int frames, int width, int height, unsigned seed, double offset, bool quick) {
   test::VirtualRoom room;
   room.cameras = cameras;
   room.frames = frames;
   room.width = width;
   room.height = height;
   room.seed = seed;
+  room.principal_offset_px = offset;
   room.board = {BoardKind::charuco, 7, 5, 100.0, 75.0, "DICT_4X4_50"};
   test::VirtualRig truth = test::make_virtual_rig(room);
   test::TempDir dir;
@@ -108,23 +132,25 @@ void run(int cameras, int frames, int width, int height, unsigned seed, bool qui
   std::printf(
       "\n## %d cameras, %d frames, %dx%d px (seed %u): render %.1f s, find the board %.1f s\n",
       cameras, frames, width, height, seed, seconds(t0, t1), seconds(t1, t2));
-  for (int mode = 0; mode < (quick ? 1 : 3); ++mode)
-    report(truth, views, mode == 0, mode == 2, search);
+  for (const Mode& mode : kModes) {
+    report(truth, views, mode, search);
+    if (quick) break;
+  }
 }
 
 void report(const test::VirtualRig& truth, const std::vector<CameraBoardViews>& views,
-            bool given_intrinsics, bool refine, const RigBoardOptions& search) {
+            const Mode& mode, const RigBoardOptions& search) {
   RigBoardOptions options = search;
-  options.refine_intrinsics = refine;
-  if (given_intrinsics) options.intrinsics = Rig{truth.cameras, std::nullopt};
+  options.refine_intrinsics = mode.refine;
+  options.tangential_distortion = mode.tangential;
+  options.square_pixels = mode.square;
+  if (mode.given) options.intrinsics = Rig{truth.cameras, std::nullopt};
   const auto t2 = std::chrono::steady_clock::now();
   const RigCalibration result = calibrate_rig(views, options);
   const auto t3 = std::chrono::steady_clock::now();
   const double seconds = std::chrono::duration<double>(t3 - t2).count();
 
-  std::printf("\n### intrinsics %s%s\n\n",
-              given_intrinsics ? "given (the truth)" : "from each camera's own frames",
-              refine ? ", refined in the bundle" : "");
+  std::printf("\n### intrinsics %s\n\n", mode.what);
   std::printf("calibrate %.2f s; %d frames with the board, floor frame %d, RMS %.3f px\n\n",
               seconds, result.frames_used, result.floor_frame, result.rms_px);
   std::vector<glm::dvec3> got, want;
@@ -136,7 +162,22 @@ void report(const test::VirtualRig& truth, const std::vector<CameraBoardViews>& 
   std::printf(
       "| camera | frames with board (shown) | corners used | dropped | RMS px | corners vs "
       "truth px | position mm | angle deg | position after rigid alignment mm | fx "
-      "error %% |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+      "error %% | cx err px | cy err px | angle after common rotation deg "
+      "|\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+  // The common rotation (estimated world -> true world) from the camera -> world rotations.
+  cv::Matx33d sum = cv::Matx33d::zeros();
+  for (std::size_t k = 0; k < result.rig.cameras.size(); ++k) {
+    const glm::dmat3 m = glm::transpose(truth.cameras[k].rotation) * result.rig.cameras[k].rotation;
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) sum(r, c) += m[c][r];
+  }
+  cv::Mat sw, su, svt;
+  cv::SVD::compute(cv::Mat(sum), sw, su, svt);
+  const cv::Matx33d G(cv::Mat(su * svt));
+  glm::dmat3 g;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) g[c][r] = G(r, c);
+  double worst_common = 0;
   Worst row;
   for (std::size_t k = 0; k < result.rig.cameras.size(); ++k) {
     const Camera& c = result.rig.cameras[k];
@@ -148,14 +189,19 @@ void report(const test::VirtualRig& truth, const std::vector<CameraBoardViews>& 
     row.max_mm = std::max(row.max_mm, mm);
     row.max_deg = std::max(row.max_deg, deg);
     const auto& r = result.cameras[k];
-    std::printf("| %s | %d (%d) | %d | %d | %.3f | %.3f | %.2f | %.3f | %.2f | %.2f |\n",
-                c.name.c_str(), r.frames_with_board, shown, r.observations, r.dropped, r.rms_px,
-                corner_error_px(views[k], t, truth), mm, deg,
-                1000 * glm::length(aligned[k] - t.centre()), 100 * (c.fx - t.fx) / t.fx);
+    const double common = rotation_error_deg(c.rotation * glm::transpose(g), t.rotation);
+    worst_common = std::max(worst_common, common);
+    std::printf(
+        "| %s | %d (%d) | %d | %d | %.3f | %.3f | %.2f | %.3f | %.2f | %.2f | %.2f | %.2f | %.3f "
+        "|\n",
+        c.name.c_str(), r.frames_with_board, shown, r.observations, r.dropped, r.rms_px,
+        corner_error_px(views[k], t, truth), mm, deg, 1000 * glm::length(aligned[k] - t.centre()),
+        100 * (c.fx - t.fx) / t.fx, c.cx - t.cx, c.cy - t.cy, common);
   }
-  std::printf("| **worst** | | | | | | **%.2f** | **%.3f** | | |\n", row.max_mm, row.max_deg);
+  std::printf("| **worst** | | | | | | **%.2f** | **%.3f** | | | | | %.3f |\n", row.max_mm,
+              row.max_deg, worst_common);
 
-  if (given_intrinsics && !refine) {
+  if (mode.given) {
     // The last camera loses the frames it shares and sees the board alone in one more frame.
     std::vector<CameraBoardViews> cut = views;
     auto& last = cut.back();
@@ -181,13 +227,17 @@ void report(const test::VirtualRig& truth, const std::vector<CameraBoardViews>& 
 
 int main(int argc, char** argv) {
   mocap::cli::Args args(
-      "mocap-bench-rig-board [--frames N] [--width PX] [--height PX] [--seed N] [--quick]",
+      "mocap-bench-rig-board [--frames N] [--width PX] [--height PX] [--seed N] [--cameras N] "
+      "[--principal-offset PX] [--quick]",
       "Board calibration of a virtual rig against the truth (synthetic "
       "renders; docs/cameras.md).");
   args.option("frames", "N", "frames per run (frame 0: the board on the floor)", "60")
       .option("width", "PX", "image width", "1280")
       .option("height", "PX", "image height", "720")
       .option("seed", "N", "scene seed", "1")
+      .option("principal-offset", "PX",
+              "each camera's principal point up to PX off the image centre (0: centred)", "0")
+      .option("cameras", "N", "only the rig of N cameras (0: the 4- and 8-camera rigs)", "0")
       .flag("quick", "only the 4-camera run with given intrinsics");
   int code = 0;
   if (!args.parse(argc - 1, argv + 1, code)) return code;
@@ -197,8 +247,16 @@ int main(int argc, char** argv) {
   const int height = static_cast<int>(args.integer("height"));
   const unsigned seed = static_cast<unsigned>(args.integer("seed"));
   try {
-    run(4, frames, width, height, seed, args.has("quick"));
-    if (!args.has("quick")) run(8, frames, width, height, seed, false);
+    const double offset = args.number("principal-offset");
+    const int only = static_cast<int>(args.integer("cameras"));
+    if (args.has("quick")) {
+      run(4, frames, width, height, seed, offset, true);
+    } else {
+      for (int cameras : {4, 8})
+        if (only == 0 || only == cameras) run(cameras, frames, width, height, seed, offset, false);
+      if (only != 0 && only != 4 && only != 8)
+        run(only, frames, width, height, seed, offset, false);
+    }
   } catch (const std::exception& e) {
     std::cerr << "mocap-bench-rig-board: " << e.what() << "\n";
     return 1;

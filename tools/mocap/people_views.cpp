@@ -160,6 +160,53 @@ void check_people_views(const std::vector<PeopleView>& views,
   }
 }
 
+void check_keypoints_fit(const PeopleView& view, const io::OpenPoseSequence& json,
+                         const camera::Camera& camera) {
+  if (view.kind != InputKind::openpose_json) return;
+  constexpr double kMargin = 0.10;    // of the image's width and height, beyond each border
+  constexpr double kMaxShare = 0.01;  // of the view's keypoints, allowed beyond the margin
+  constexpr long kMinOutside = 3;
+  const double w = camera.width, h = camera.height;
+  const auto beyond = [&](const Keypoint2D& k) {  // how far outside, in image sizes (0: inside)
+    const double dx = std::max({0.0, -k.x / w, (k.x - w) / w});
+    const double dy = std::max({0.0, -k.y / h, (k.y - h) / h});
+    return std::max(dx, dy);
+  };
+  long total = 0, outside = 0;
+  double min_x = 0, max_x = 0, min_y = 0, max_y = 0, worst = 0;
+  std::size_t worst_frame = 0;
+  for (std::size_t f = 0; f < json.frames.size(); ++f)
+    for (const Person2D& person : json.frames[f].people)
+      for (const Keypoint2D& k : person.joints) {
+        if (!(k.confidence > 0) || !std::isfinite(k.x) || !std::isfinite(k.y)) continue;
+        min_x = total ? std::min<double>(min_x, k.x) : k.x;
+        max_x = total ? std::max<double>(max_x, k.x) : k.x;
+        min_y = total ? std::min<double>(min_y, k.y) : k.y;
+        max_y = total ? std::max<double>(max_y, k.y) : k.y;
+        ++total;
+        const double b = beyond(k);
+        if (b <= kMargin) continue;
+        ++outside;
+        if (b > worst) worst = b, worst_frame = f;
+      }
+  if (outside < kMinOutside || static_cast<double>(outside) <= kMaxShare * total) return;
+  // The file of the farthest keypoint (frames[i] is frame number first_frame + i).
+  fs::path file = view.json;
+  const std::int64_t number = json.first_frame + static_cast<std::int64_t>(worst_frame);
+  for (const io::FrameFile& f : io::list_frame_files(view.json))
+    if (f.number == number) file = f.path;
+  std::ostringstream what;
+  what.precision(0);
+  what << std::fixed << "camera '" << camera.name << "' is "
+       << size_text(camera.width, camera.height) << " but " << outside << " of the " << total
+       << " keypoints of " << view.path << " lie more than " << 100 * kMargin
+       << " % of the image outside it (keypoints span x " << min_x << ".." << max_x << ", y "
+       << min_y << ".." << max_y << "; the farthest in " << file.string()
+       << "): give the views in the cameras' order, with the intrinsics (or "
+       << "--size) of the images the keypoints were detected in";
+  throw InputError(camera.name, what.str());
+}
+
 void detect_people(std::vector<PeopleView>& views, const std::vector<camera::Camera>& cameras,
                    const PeopleViewsOptions& options) {
   bool any = false;

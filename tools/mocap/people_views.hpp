@@ -13,6 +13,7 @@
 
 #include "camera/camera.hpp"
 #include "input_kind.hpp"
+#include "io/openpose_json.hpp"
 
 namespace mocap::cli {
 
@@ -45,6 +46,17 @@ std::vector<PeopleView> open_people_views(const std::vector<std::string>& paths,
 // lengths.
 void check_people_views(const std::vector<PeopleView>& views,
                         const std::vector<camera::Camera>& cameras);
+
+// Refused (InputError naming the camera and the file of the farthest keypoint): an OpenPose JSON
+// view whose keypoints do not fit inside its camera's image. OpenPose JSON carries no image size,
+// so the keypoints' extent is the check: more than 1 % of the view's keypoints (and at least 3)
+// beyond 10 % of the image's width or height outside its border means the JSON was made from
+// images of another size (a swapped width and height, a resized video) or belongs to another
+// camera (the views out of the rig's order). The margin and the share allow what detectors do at
+// the border (a joint cut off by the frame placed a little outside it) and a stray detection.
+// Videos and image folders are checked by their size (check_people_views).
+void check_keypoints_fit(const PeopleView& view, const io::OpenPoseSequence& json,
+                         const camera::Camera& camera);
 
 // Runs the detector on every video view (frames of each view counted on a progress bar), writing
 // options.keypoints / <camera name> / <camera name>_<frame>_keypoints.json, and sets the views'
