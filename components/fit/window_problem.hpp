@@ -65,6 +65,30 @@ struct WindowFrame {
   bool constant;  // frozen: anchors the terms of its neighbours, not solved
 };
 
+// The last frames a windowed fit emitted (at most two, consecutive, valid), frozen: the next
+// window is solved after them, so that its smoothness and contact terms join it continuously to
+// what was already emitted (WindowedFitter, MultiViewWindowedFitter).
+class FrozenAnchors {
+ public:
+  // A valid frame was emitted: the newest anchor (the oldest of three leaves).
+  void emitted(const FrameVars& vars, const FrameData& data) {
+    vars_.push_back(vars), data_.push_back(data);
+    if (vars_.size() > 2) vars_.erase(vars_.begin()), data_.erase(data_.begin());
+  }
+  // An invalid frame was emitted: the next window starts free.
+  void clear() { vars_.clear(), data_.clear(); }
+  // The anchors, oldest first and constant, at the start of a window's problem.
+  void add_to(std::vector<WindowFrame>& problem) {
+    for (std::size_t a = 0; a < vars_.size(); ++a) problem.push_back({&vars_[a], &data_[a], true});
+  }
+  bool empty() const { return vars_.empty(); }
+  std::size_t size() const { return vars_.size(); }
+
+ private:
+  std::vector<FrameVars> vars_;
+  std::vector<FrameData> data_;
+};
+
 struct WindowSolve {
   bool solve_bones = false;
   int max_iterations = 20;

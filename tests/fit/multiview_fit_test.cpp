@@ -2,7 +2,9 @@
 // 3 people, 4 cameras, the target degradation (σ 2 %, drops, outliers, false detections,
 // occlusion), reconstructed by components/multiview and then fitted live and in full.
 
+#include <algorithm>
 #include <cmath>
+#include <iostream>
 #include <map>
 #include <stdexcept>
 #include <vector>
@@ -11,6 +13,7 @@
 
 #include "fit/multiview_fit.hpp"
 #include "fit/multiview_input.hpp"
+#include "fit/multiview_people_fitter.hpp"
 #include "fit/scene_fit.hpp"
 #include "multiview/scene_fixture.hpp"
 
@@ -108,6 +111,66 @@ TEST(MultiViewFit, LiveAndFullBeatTheTriangulationWithConstantBones) {
     EXPECT_LT(worst_bone_std_m(results), 1e-4);
     EXPECT_EQ(fitted.id_switches, triangulated.id_switches);
   }
+}
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v.empty() ? 0.0 : v[v.size() / 2];
+}
+
+TEST(MultiViewFit, FullModeWindowsJoinAsSmoothlyAsTheyMoveInside) {
+  MOCAP_REQUIRE_SCENE_CLIPS();
+  // The stream's full mode (MultiViewPeopleFitter) in windows of 30 sets, 10 of them solved again
+  // with the next: each window is solved after the two frames emitted before it (frozen), so the
+  // motion across a join is as smooth as inside a window. Solved alone, each window's first frames
+  // moved by centimetres against the previous window's last ones.
+  const Scene s = reconstruct(2);
+  MultiViewPeopleFitOptions o;
+  o.mode = StreamFitMode::full;
+  o.fit = options_for(s);
+  o.window = {30, 10};
+  MultiViewPeopleFitter fitter(o);
+  std::vector<People3D> out;
+  for (std::size_t f = 0; f < s.results.size(); ++f) {
+    People3D frame;
+    frame.header.frame = static_cast<std::int64_t>(f);
+    for (const auto& person : s.results[f].people)
+      if (person.id >= 0) frame.people.emplace_back().id = person.id;
+    for (People3D& done :
+         fitter.push(s.input[f], s.results[f], multiview::KeypointSet::body15(), std::move(frame)))
+      out.push_back(std::move(done));
+  }
+  for (People3D& done : fitter.finish()) out.push_back(std::move(done));
+  ASSERT_EQ(out.size(), s.results.size());
+  // Per track, its fitted joints by frame; the acceleration |p(f+1) - 2 p(f) + p(f-1)| of every
+  // joint at the two frames either side of a join (frames 20k - 1 and 20k of the track: windows
+  // emit 20 frames each) and inside.
+  std::map<int, std::vector<std::pair<std::int64_t, Body>>> tracks;
+  for (const People3D& frame : out)
+    for (const Person3D& p : frame.people)
+      if (p.placed) tracks[p.id].emplace_back(frame.header.frame, joints_in_frame(p));
+  std::vector<double> at_join, inside;
+  int joins = 0;
+  for (const auto& [id, track] : tracks) {
+    for (std::size_t k = 1; k + 1 < track.size(); ++k) {
+      if (track[k + 1].first - track[k - 1].first != 2) continue;  // a gap
+      const bool join = (k + 1) % 20 == 0 || k % 20 == 0;
+      joins += k % 20 == 0 ? 1 : 0;
+      for (int j = 0; j < kBodyJoints; ++j) {
+        const glm::vec3 a =
+            track[k + 1].second[j] - 2.0f * track[k].second[j] + track[k - 1].second[j];
+        (join ? at_join : inside).push_back(1000.0 * glm::length(a));
+      }
+    }
+  }
+  ASSERT_GE(joins, 6);
+  const double join_max = *std::max_element(at_join.begin(), at_join.end());
+  const double inside_max = *std::max_element(inside.begin(), inside.end());
+  std::cout << joins << " joins: acceleration at the joins median " << median(at_join)
+            << " mm, max " << join_max << " mm; inside median " << median(inside) << " mm, max "
+            << inside_max << " mm\n";
+  EXPECT_LT(median(at_join), 1.5 * median(inside));
+  EXPECT_LT(join_max, inside_max);
 }
 
 TEST(MultiViewFit, ExactKeypointsGiveTheTruthBack) {
