@@ -104,6 +104,7 @@ FrameData frame_data(const MultiViewFrameInput& in, const Directions& directions
   FrameData d;
   d.observed = observed(in);
   d.d0 = directions;
+  d.time = in.time;
   if (!d.observed) return d;
   d.contact = in.contact;
   const glm::vec3 root = in.triangulated[kRoot];

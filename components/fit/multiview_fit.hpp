@@ -12,6 +12,7 @@
 // takes them): the fit uses each camera's pinhole and pose only.
 
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <span>
@@ -36,6 +37,10 @@ struct MultiViewFrameInput {
   // multiview::FrameResult::body_of. The frame is fitted when its root is triangulated.
   Body triangulated = not_triangulated();
   std::array<bool, 2> contact{};  // right, left ankle in contact with the floor (kFeet order)
+  // When the frame set was taken, in frame periods (its frame number: flow.set_limiter numbers
+  // its sets with gaps where it dropped some): the smoothness terms take a gap of k periods as k
+  // steps. NaN: one period after the frame before it.
+  double time = std::numeric_limits<double>::quiet_NaN();
 
   static Body not_triangulated();
 };

@@ -27,6 +27,9 @@ struct MultiViewPeopleFitter::State {
       if (person.id >= 0) ids.push_back(person.id);
     std::sort(ids.begin(), ids.end());
     people += static_cast<std::int64_t>(ids.size());
+    // The set's number is its time: the limiter's gaps (dropped sets) are steps of the fit.
+    const auto time = static_cast<double>(frame.header.frame);
+    tracks.gap().time = time;
     const std::int64_t t = tracks.hold(std::move(frame), ids);
     if (result) {
       for (std::size_t p = 0; p < result->people.size(); ++p) {
@@ -34,6 +37,7 @@ struct MultiViewPeopleFitter::State {
         if (id < 0 || !std::binary_search(ids.begin(), ids.end(), id)) continue;
         tracks.see(id, t, [&]() -> const MultiViewFrameInput& {
           multiview_input(*observations, *result, p, *set, input);
+          input.time = time;
           return input;
         });
       }

@@ -4,6 +4,7 @@
 // that includes Ceres besides nothing else). Not part of the library's interface.
 
 #include <array>
+#include <limits>
 #include <span>
 #include <vector>
 
@@ -48,6 +49,9 @@ struct FrameData {
   double sigma_px = 0.0;            // one reprojection sigma in pixels (0: no reprojection term)
   std::array<double, 4> pinhole{};  // fx, fy, cx, cy of the camera that saw the keypoints
   std::array<bool, 2> contact{};
+  // When the frame was taken, in frame periods (its frame number): the smoothness and contact
+  // terms take two frames k periods apart as k steps. NaN: one step after the frame before it.
+  double time = std::numeric_limits<double>::quiet_NaN();
   bool has_start = false;           // the closed-form translation exists
   std::array<double, 3> start_t{};  // closed-form root translation (camera frame)
   std::array<double, 9> rotation{1, 0, 0, 0, 1, 0, 0, 0, 1};  // camera -> world, row-major
