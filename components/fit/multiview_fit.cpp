@@ -104,6 +104,7 @@ FrameData frame_data(const MultiViewFrameInput& in, const Directions& directions
   FrameData d;
   d.observed = observed(in);
   d.d0 = directions;
+  d.time = in.time;
   if (!d.observed) return d;
   d.contact = in.contact;
   const glm::vec3 root = in.triangulated[kRoot];
@@ -195,6 +196,135 @@ FitResult fit_multiview_sequence(std::span<const MultiViewFrameInput> frames,
   for (std::size_t i = 0; i < n; ++i)
     result.frames[first + i] = output(vars[i], data[i], bones, true);
   return result;
+}
+
+// ---- Full mode in windows ----
+
+struct MultiViewWindowedFitter::State {
+  MultiViewFitOptions options;
+  WindowOptions window;
+  std::optional<Bones> bones;  // solved by the first window, kept by the next ones
+  BoneLengths lengths;
+  FitStats stats;
+  FrozenAnchors anchors;                        // the last emitted frames
+  std::optional<std::array<double, 3>> last_t;  // root of the latest emitted valid frame
+  // Each bone's direction at the latest emitted frame, and whether a triangulation gave it.
+  Directions known{};
+  std::array<bool, kBones> seen{};
+  // Held frames, oldest first; `warm`: their data and vars are an earlier window's solution.
+  std::vector<MultiViewFrameInput> inputs;
+  std::vector<FrameData> data;
+  std::vector<FrameVars> vars;
+  std::vector<bool> warm;
+
+  // The directions a window starts from: the last emitted frame's; a bone not triangulated so
+  // far takes its first triangulated direction in the window (as fit_multiview_sequence).
+  Directions start_directions() const {
+    Directions d = known;
+    std::array<bool, kBones> found = seen;
+    for (const MultiViewFrameInput& in : inputs)
+      for (int b = 0; b < kBones; ++b)
+        if (!found[b])
+          if (const auto direction = bone_direction(in.triangulated, b))
+            d[b] = *direction, found[b] = true;
+    return d;
+  }
+
+  // Solves the held frames after the anchors (unless !solve), returns the first `emit` of them
+  // and forgets those.
+  std::vector<FittedFrame> solve_and_emit(std::size_t emit, int iterations, double seconds,
+                                          bool solve) {
+    const std::size_t n = inputs.size();
+    std::vector<bool> valid(n, false);
+    std::size_t first = n, last = 0;
+    for (std::size_t i = 0; i < n; ++i)
+      if (observed(inputs[i])) first = std::min(first, i), last = i;
+    if (solve && first < n) {
+      if (!anchors.empty()) first = 0;  // a gap after the emitted frames is filled from them
+      const FitOptions& fit = options.fit;
+      Directions directions = start_directions();
+      std::optional<std::array<double, 3>> carry;
+      if (!anchors.empty()) carry = last_t;
+      std::vector<WindowFrame> problem;
+      anchors.add_to(problem);
+      for (std::size_t i = 0; i <= last; ++i) {
+        directions_of(inputs[i].triangulated, directions);
+        if (i < first) continue;
+        if (!warm[i]) {
+          data[i] = frame_data(inputs[i], directions, options);
+          vars[i] = FrameVars{};
+          if (data[i].has_start) carry = data[i].start_t;
+          vars[i].t = *carry;  // the first frame solved is observed, or follows an anchor
+        }
+        carry = vars[i].t;
+        valid[i] = true;
+        problem.push_back({&vars[i], &data[i], false});
+      }
+      Bones b = bones ? *bones
+                      : to_bones(fit.bones && usable(*fit.bones)
+                                     ? *fit.bones
+                                     : filled(triangulated_bone_lengths(inputs)));
+      const Bones initial = b;
+      count(stats, solve_window(problem, b, initial, fit,
+                                {!bones && fit.solve_bones, iterations, false, seconds}));
+      if (!bones) bones = b, lengths = from_bones(b);
+    }
+    std::vector<FittedFrame> out;
+    out.reserve(emit);
+    for (std::size_t i = 0; i < emit; ++i) {
+      if (valid[i]) {
+        out.push_back(output(vars[i], data[i], *bones, true));
+        anchors.emitted(vars[i], data[i]);
+        last_t = vars[i].t;
+      } else {
+        out.emplace_back();
+        anchors.clear();
+      }
+      for (int b = 0; b < kBones; ++b)
+        if (const auto d = bone_direction(inputs[i].triangulated, b)) known[b] = *d, seen[b] = true;
+    }
+    for (std::size_t i = emit; i < n; ++i) warm[i] = valid[i];
+    const auto drop = static_cast<std::ptrdiff_t>(emit);
+    inputs.erase(inputs.begin(), inputs.begin() + drop);
+    data.erase(data.begin(), data.begin() + drop);
+    vars.erase(vars.begin(), vars.begin() + drop);
+    warm.erase(warm.begin(), warm.begin() + drop);
+    return out;
+  }
+};
+
+MultiViewWindowedFitter::MultiViewWindowedFitter(MultiViewFitOptions options, WindowOptions window)
+    : state_(std::make_unique<State>()) {
+  State& s = *state_;
+  s.options = std::move(options);
+  s.window.frames = std::max(window.frames, 2);
+  s.window.overlap = std::clamp(window.overlap, 0, s.window.frames - 1);
+  s.known = default_directions(s.options.fit);
+}
+MultiViewWindowedFitter::~MultiViewWindowedFitter() = default;
+MultiViewWindowedFitter::MultiViewWindowedFitter(MultiViewWindowedFitter&&) noexcept = default;
+MultiViewWindowedFitter& MultiViewWindowedFitter::operator=(MultiViewWindowedFitter&&) noexcept =
+    default;
+const BoneLengths& MultiViewWindowedFitter::bones() const { return state_->lengths; }
+const FitStats& MultiViewWindowedFitter::stats() const { return state_->stats; }
+
+std::vector<FittedFrame> MultiViewWindowedFitter::push(const MultiViewFrameInput& frame,
+                                                       bool solve) {
+  State& s = *state_;
+  s.inputs.push_back(frame);
+  s.data.emplace_back();
+  s.vars.emplace_back();
+  s.warm.push_back(false);
+  if (!solve || s.inputs.size() < static_cast<std::size_t>(s.window.frames)) return {};
+  return s.solve_and_emit(s.inputs.size() - static_cast<std::size_t>(s.window.overlap),
+                          s.options.fit.max_iterations, 0.0, true);
+}
+
+std::vector<FittedFrame> MultiViewWindowedFitter::finish(std::optional<SolveBudget> budget) {
+  State& s = *state_;
+  if (!budget) return s.solve_and_emit(s.inputs.size(), s.options.fit.max_iterations, 0.0, true);
+  return s.solve_and_emit(s.inputs.size(), budget->iterations, budget->seconds,
+                          budget->seconds > 0.0 && budget->iterations > 0);
 }
 
 // ---- Live mode ----

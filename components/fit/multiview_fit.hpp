@@ -12,6 +12,7 @@
 // takes them): the fit uses each camera's pinhole and pose only.
 
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <span>
@@ -36,6 +37,10 @@ struct MultiViewFrameInput {
   // multiview::FrameResult::body_of. The frame is fitted when its root is triangulated.
   Body triangulated = not_triangulated();
   std::array<bool, 2> contact{};  // right, left ankle in contact with the floor (kFeet order)
+  // When the frame set was taken, in frame periods (its frame number: flow.set_limiter numbers
+  // its sets with gaps where it dropped some): the smoothness terms take a gap of k periods as k
+  // steps. NaN: one period after the frame before it.
+  double time = std::numeric_limits<double>::quiet_NaN();
 
   static Body not_triangulated();
 };
@@ -66,6 +71,35 @@ BoneLengths triangulated_bone_lengths(std::span<const MultiViewFrameInput> frame
 // quick solve).
 FitResult fit_multiview_sequence(std::span<const MultiViewFrameInput> frames,
                                  const MultiViewFitOptions& options, double max_seconds = 0.0);
+
+// Full mode in windows (streaming), as WindowedFitter: a track's frames are solved in windows of
+// `window.frames` frames as they fill; each window is solved after the two frames emitted before
+// it (frozen anchors: its smoothness and contact terms join it continuously to what was emitted),
+// and all its frames but the last `window.overlap` are emitted (final); the overlap frames start
+// the next window from their solution. The first window solves the bone lengths (from the
+// triangulated medians, or options.fit.bones), the next ones keep them. Frames before the
+// person's first triangulated root and after the last one held are invalid. A track shorter than
+// a window is one solve, the same as fit_multiview_sequence.
+class MultiViewWindowedFitter {
+ public:
+  MultiViewWindowedFitter(MultiViewFitOptions options, WindowOptions window);
+  ~MultiViewWindowedFitter();
+  MultiViewWindowedFitter(MultiViewWindowedFitter&&) noexcept;
+  MultiViewWindowedFitter& operator=(MultiViewWindowedFitter&&) noexcept;
+
+  // Adds the next frame; returns the frames that became final, in order (a window's worth when
+  // one was solved). solve = false only holds it (a stop: finish() solves within a budget).
+  std::vector<FittedFrame> push(const MultiViewFrameInput& frame, bool solve = true);
+  // Every held frame, solved as a last window; with a budget, one quick solve of at most its
+  // iterations and time, or none (frames invalid) when its time is out.
+  std::vector<FittedFrame> finish(std::optional<SolveBudget> budget = std::nullopt);
+  const BoneLengths& bones() const;  // empty until the first window is solved
+  const FitStats& stats() const;
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
 
 // Fixed-lag live mode, as LiveFitter: each push solves the newest lag + 1 frames against the two
 // emitted, frozen ones before them and returns the frame that is now `lag` frames old. The bone

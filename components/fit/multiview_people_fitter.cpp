@@ -9,66 +9,10 @@
 
 namespace mocap::fit {
 
-namespace {
-
-// Full mode for one track: windows solved as they fill, the first solving the bone lengths.
-class WindowedTrack {
- public:
-  WindowedTrack(const MultiViewFitOptions& options, WindowOptions window)
-      : options_(options), window_(window) {
-    window_.frames = std::max(window_.frames, 2);
-    window_.overlap = std::clamp(window_.overlap, 0, window_.frames - 1);
-  }
-
-  std::vector<FittedFrame> push(const MultiViewFrameInput& in, bool solve) {
-    inputs_.push_back(in);
-    if (!solve || inputs_.size() < static_cast<std::size_t>(window_.frames)) return {};
-    return solve_and_emit(inputs_.size() - static_cast<std::size_t>(window_.overlap),
-                          options_.fit.max_iterations, 0.0);
-  }
-
-  // Every held frame; with a budget (a stop), one quick solve, none when its time is out.
-  std::vector<FittedFrame> finish(std::optional<SolveBudget> budget) {
-    if (!budget) return solve_and_emit(inputs_.size(), options_.fit.max_iterations, 0.0);
-    if (budget->seconds <= 0.0 || budget->iterations <= 0) {
-      std::vector<FittedFrame> unsolved(inputs_.size());
-      inputs_.clear();
-      return unsolved;
-    }
-    return solve_and_emit(inputs_.size(), budget->iterations, budget->seconds);
-  }
-
-  const FitStats& stats() const { return stats_; }
-
- private:
-  // Solves the held frames, returns the first `emit` of them and forgets those.
-  std::vector<FittedFrame> solve_and_emit(std::size_t emit, int iterations, double seconds) {
-    if (inputs_.empty()) return {};
-    MultiViewFitOptions o = options_;
-    o.fit.max_iterations = iterations;
-    if (bones_) o.fit.bones = *bones_, o.fit.solve_bones = false;
-    FitResult result = fit_multiview_sequence(inputs_, o, seconds);
-    add(stats_, result.stats);
-    const bool any = std::any_of(result.frames.begin(), result.frames.end(),
-                                 [](const FittedFrame& f) { return f.valid; });
-    if (any && !bones_) bones_ = result.bones;
-    result.frames.resize(emit);
-    inputs_.erase(inputs_.begin(), inputs_.begin() + static_cast<std::ptrdiff_t>(emit));
-    return std::move(result.frames);
-  }
-
-  MultiViewFitOptions options_;
-  WindowOptions window_;
-  std::vector<MultiViewFrameInput> inputs_;
-  std::optional<BoneLengths> bones_;  // solved by the first window, kept by the next ones
-  FitStats stats_;
-};
-
-}  // namespace
-
 struct MultiViewPeopleFitter::State {
   MultiViewPeopleFitOptions options;
-  TrackFitters<MultiViewPeopleFitOptions, MultiViewFrameInput, MultiViewLiveFitter, WindowedTrack>
+  TrackFitters<MultiViewPeopleFitOptions, MultiViewFrameInput, MultiViewLiveFitter,
+               MultiViewWindowedFitter>
       tracks{options, MultiViewFrameInput{}};
   MultiViewFrameInput input;  // reused
   std::int64_t people = 0;
@@ -83,6 +27,9 @@ struct MultiViewPeopleFitter::State {
       if (person.id >= 0) ids.push_back(person.id);
     std::sort(ids.begin(), ids.end());
     people += static_cast<std::int64_t>(ids.size());
+    // The set's number is its time: the limiter's gaps (dropped sets) are steps of the fit.
+    const auto time = static_cast<double>(frame.header.frame);
+    tracks.gap().time = time;
     const std::int64_t t = tracks.hold(std::move(frame), ids);
     if (result) {
       for (std::size_t p = 0; p < result->people.size(); ++p) {
@@ -90,6 +37,7 @@ struct MultiViewPeopleFitter::State {
         if (id < 0 || !std::binary_search(ids.begin(), ids.end(), id)) continue;
         tracks.see(id, t, [&]() -> const MultiViewFrameInput& {
           multiview_input(*observations, *result, p, *set, input);
+          input.time = time;
           return input;
         });
       }

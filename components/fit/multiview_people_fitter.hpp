@@ -10,9 +10,10 @@
 //
 // Each track id has its own fitter. live: MultiViewLiveFitter (fixed lag; a new track's first
 // `bone_frames` observed frames are held until its bone lengths are known, then all leave at
-// once). full: windows of `window.frames` frames per track solved as they fill (the first
-// solves the bone lengths, the next ones keep them), the last `window.overlap` frames solved
-// again with the next window; a frame leaves when its window is solved. A frame leaves once every
+// once). full: MultiViewWindowedFitter, windows of `window.frames` frames per track solved as
+// they fill, each after the two frames emitted before it (frozen anchors), the last
+// `window.overlap` frames solved again with the next window; a frame leaves when its window is
+// solved. A frame leaves once every
 // person in it is decided (recon::HeldFrames), so the output is delayed by at most:
 //   live: lag frames, or bone_frames + lag frames while a track is new;
 //   full: window.frames frames (a person missing longer than `max_missed` frames ends their

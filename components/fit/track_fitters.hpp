@@ -53,6 +53,9 @@ class TrackFitters {
     return held_.hold(std::move(frame), std::move(ids));
   }
   const People3D& frame(std::int64_t t) { return *held_.find(t); }
+  // The input pushed for a person absent from a frame: the owner may set what depends on the
+  // frame (its time) before the frame's see() and end_frame().
+  Input& gap() { return gap_; }
 
   // Person `id` seen in held frame `t`: their track (started if new) gets the frames it missed as
   // gaps, then `make_input()`. The id twice in one frame: the first one counts.

@@ -112,6 +112,23 @@ using Difference = std::array<double, 3>;
 constexpr Difference kAcceleration = {1.0, -2.0, 1.0};
 constexpr Difference kVelocity = {0.0, -1.0, 1.0};
 
+// Frames a and b (consecutive in a window) are this many frame periods apart: their times'
+// difference, or 1 where a time is unknown or does not increase.
+double step(const FrameData& a, const FrameData& b) {
+  const double h = b.time - a.time;
+  return std::isfinite(h) && h > 0.0 ? h : 1.0;
+}
+
+// The difference of three frames h1 and h2 periods apart: the second difference as an
+// acceleration per period², or (velocity) the first difference of the last two as a velocity per
+// period; weighted by the square root of the time it stands for, so that a gap of k periods costs
+// what the k steps of the same motion would. h1 = h2 = 1 gives kAcceleration, kVelocity.
+Difference difference(double h1, double h2, bool velocity) {
+  if (velocity) return {0.0, -1.0 / std::sqrt(h2), 1.0 / std::sqrt(h2)};
+  const double w = std::sqrt(0.5 * (h1 + h2));
+  return {w * 2.0 / (h1 * (h1 + h2)), -w * 2.0 / (h1 * h2), w * 2.0 / (h2 * (h1 + h2))};
+}
+
 struct BoneAccelCost {
   const FrameData* f[3];
   int bone;
@@ -425,9 +442,10 @@ WindowSummary solve_window(std::span<const WindowFrame> frames, Bones& bones,
     for (int s = 0; s < 2; ++s) {
       if (!a.data->contact[s] || !b.data->contact[s]) continue;
       const Chain& chain = chains[kFeet[s]];
+      // A foot's slide over k periods costs what k steps of it would.
+      const double inv_sigma = 1.0 / (wt.slide_m * std::sqrt(step(*a.data, *b.data)));
       auto cost = std::make_unique<Dynamic<SlideCost>>(
-          std::make_unique<SlideCost>(SlideCost{a.data, b.data, chain, 1.0 / wt.slide_m})
-              .release());
+          std::make_unique<SlideCost>(SlideCost{a.data, b.data, chain, inv_sigma}).release());
       std::vector<double*> blocks = {a.vars->t.data(), b.vars->t.data(), bones.data()};
       cost->AddParameterBlock(3);
       cost->AddParameterBlock(3);
@@ -443,12 +461,13 @@ WindowSummary solve_window(std::span<const WindowFrame> frames, Bones& bones,
   }
   // Smoothness: accelerations, or velocities when only the newest frame is free (live, lag 0:
   // anchoring it by the acceleration to two frozen frames extrapolates their motion).
-  const Difference& diff = solve.velocity_smoothing ? kVelocity : kAcceleration;
   const double root_sigma = solve.velocity_smoothing ? wt.root_velocity_m : wt.root_accel_m;
   const double bone_sigma = solve.velocity_smoothing ? wt.bone_velocity_m : wt.bone_accel_m;
   for (std::size_t i = 0; i + 2 < frames.size(); ++i) {
     const WindowFrame* f[3] = {&frames[i], &frames[i + 1], &frames[i + 2]};
     if (f[0]->constant && f[1]->constant && f[2]->constant) continue;
+    const Difference diff = difference(step(*f[0]->data, *f[1]->data),
+                                       step(*f[1]->data, *f[2]->data), solve.velocity_smoothing);
     problem.AddResidualBlock(
         std::make_unique<ceres::AutoDiffCostFunction<RootAccelCost, 3, 3, 3, 3>>(
             std::make_unique<RootAccelCost>(

@@ -4,6 +4,7 @@
 // that includes Ceres besides nothing else). Not part of the library's interface.
 
 #include <array>
+#include <limits>
 #include <span>
 #include <vector>
 
@@ -48,6 +49,9 @@ struct FrameData {
   double sigma_px = 0.0;            // one reprojection sigma in pixels (0: no reprojection term)
   std::array<double, 4> pinhole{};  // fx, fy, cx, cy of the camera that saw the keypoints
   std::array<bool, 2> contact{};
+  // When the frame was taken, in frame periods (its frame number): the smoothness and contact
+  // terms take two frames k periods apart as k steps. NaN: one step after the frame before it.
+  double time = std::numeric_limits<double>::quiet_NaN();
   bool has_start = false;           // the closed-form translation exists
   std::array<double, 3> start_t{};  // closed-form root translation (camera frame)
   std::array<double, 9> rotation{1, 0, 0, 0, 1, 0, 0, 0, 1};  // camera -> world, row-major
@@ -63,6 +67,30 @@ struct WindowFrame {
   FrameVars* vars;
   const FrameData* data;
   bool constant;  // frozen: anchors the terms of its neighbours, not solved
+};
+
+// The last frames a windowed fit emitted (at most two, consecutive, valid), frozen: the next
+// window is solved after them, so that its smoothness and contact terms join it continuously to
+// what was already emitted (WindowedFitter, MultiViewWindowedFitter).
+class FrozenAnchors {
+ public:
+  // A valid frame was emitted: the newest anchor (the oldest of three leaves).
+  void emitted(const FrameVars& vars, const FrameData& data) {
+    vars_.push_back(vars), data_.push_back(data);
+    if (vars_.size() > 2) vars_.erase(vars_.begin()), data_.erase(data_.begin());
+  }
+  // An invalid frame was emitted: the next window starts free.
+  void clear() { vars_.clear(), data_.clear(); }
+  // The anchors, oldest first and constant, at the start of a window's problem.
+  void add_to(std::vector<WindowFrame>& problem) {
+    for (std::size_t a = 0; a < vars_.size(); ++a) problem.push_back({&vars_[a], &data_[a], true});
+  }
+  bool empty() const { return vars_.empty(); }
+  std::size_t size() const { return vars_.size(); }
+
+ private:
+  std::vector<FrameVars> vars_;
+  std::vector<FrameData> data_;
 };
 
 struct WindowSolve {

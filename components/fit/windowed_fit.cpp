@@ -32,9 +32,7 @@ struct WindowedFitter::State {
   BoneLengths lengths;  // initial (start) lengths: the closed-form translations use them
   BoneLengths solved_lengths;
   FitStats stats;
-  // The last emitted frames (at most two, oldest first, consecutive, valid): frozen anchors.
-  std::vector<FrameVars> anchor_vars;
-  std::vector<FrameData> anchor_data;
+  FrozenAnchors anchors;  // the last emitted frames
   // Held frames, oldest first; `warm`: vars hold an earlier window's solution.
   std::vector<FrameInput> inputs;
   std::vector<FrameVars> vars;
@@ -118,8 +116,7 @@ std::vector<FittedFrame> WindowedFitter::State::solve_and_emit(std::size_t emit,
     carry.reset();
     for (std::size_t i = n; i-- > 0;) t0[i] ? void(carry = t0[i]) : void(t0[i] = carry);
     std::vector<WindowFrame> problem;
-    for (std::size_t a = 0; a < anchor_vars.size(); ++a)
-      problem.push_back({&anchor_vars[a], &anchor_data[a], true});
+    anchors.add_to(problem);
     // Every frame has a reference here (one is observed); the translations exist for all or
     // none (a window where no keypoints give one, before any was emitted: left invalid).
     for (std::size_t i = 0; i < n; ++i) {
@@ -128,7 +125,7 @@ std::vector<FittedFrame> WindowedFitter::State::solve_and_emit(std::size_t emit,
       if (!warm[i]) vars[i] = FrameVars{}, vars[i].t = *t0[i];
       problem.push_back({&vars[i], &data[i], false});
     }
-    if (problem.size() > anchor_vars.size()) {
+    if (problem.size() > anchors.size()) {
       const auto summary = solve_window(problem, bones, initial, options,
                                         {how.solve_bones && !started && options.solve_bones,
                                          how.max_iterations, false, how.max_seconds});
@@ -143,13 +140,10 @@ std::vector<FittedFrame> WindowedFitter::State::solve_and_emit(std::size_t emit,
     const bool ok = i < n && valid[i];
     out.push_back(ok ? output(vars[i], data[i], bones, true) : FittedFrame{});
     if (ok) {
-      anchor_vars.push_back(vars[i]);
-      anchor_data.push_back(data[i]);
-      if (anchor_vars.size() > 2)
-        anchor_vars.erase(anchor_vars.begin()), anchor_data.erase(anchor_data.begin());
+      anchors.emitted(vars[i], data[i]);
       last_t = vars[i].t;
     } else {
-      anchor_vars.clear(), anchor_data.clear();
+      anchors.clear();
     }
     if (observed(inputs[i]))
       reference = inputs[i].retrieved, reference_index = first + static_cast<std::int64_t>(i);

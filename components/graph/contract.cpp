@@ -83,6 +83,9 @@ void Contract::join(JoinSpec spec) {
                 "joined inputs: a set still incomplete after this wall-clock wait goes on "
                 "partial; 0: no limit",
                 {0.0, 1e7});
+  param_choice("sync_late", spec.late == LateMessages::pass ? "pass" : "drop", {"pass", "drop"},
+               "joined inputs: a message that comes after its set went on (sync_wait_ms, "
+               "sync_bound) is passed on alone (pass) or counted and dropped (drop)");
   join_ = std::move(spec);
 }
 

@@ -34,6 +34,12 @@ enum class PortFlag { required, optional };
 // What the inputs of a set are matched by (graph/synchronizer.hpp).
 enum class SyncKey { frame, capture_time };
 
+// What becomes of a message that arrives after its set went on without it (graph/synchronizer.hpp).
+enum class LateMessages {
+  pass,  // passed on alone, as a set of its own (a sink that draws or records every message)
+  drop,  // counted and dropped: a node that makes one output per set (never two for one frame)
+};
+
 // A node's joined inputs: process() is called once per set of messages that belong together (the
 // same frame number, or capture times within a tolerance) instead of once per message. The
 // contract gives the defaults of the parameters that tune it (sync_by, sync_bound,
@@ -44,6 +50,7 @@ struct JoinSpec {
   std::int64_t bound = 64;  // messages held per port at most
   double tolerance_ms = 0;  // capture_time: how far apart the messages of one set may be
   double wait_ms = 0;       // a partial set goes on after this wall-clock wait; 0: never
+  LateMessages late = LateMessages::pass;
 };
 
 class Contract {

@@ -25,6 +25,8 @@ SyncOptions sync_options(const std::map<std::string, ParamValue>& params, AtBoun
   options.tolerance_ns =
       options.key == SyncKey::capture_time ? milliseconds(value("sync_tolerance_ms")) : 0;
   options.wait = std::chrono::nanoseconds(milliseconds(value("sync_wait_ms")));
+  options.late =
+      std::get<std::string>(value("sync_late")) == "drop" ? LateMessages::drop : LateMessages::pass;
   options.at_bound = at_bound;
   return options;
 }

@@ -47,6 +47,7 @@ std::string format_sync_stats(const SyncStats& sync) {
   for (const SyncInputStats& input : sync.inputs) {
     out << "; " << input.name << ": " << input.missing << " missing";
     if (input.late) out << ", " << input.late << " late";
+    if (input.late_dropped) out << " (" << input.late_dropped << " dropped)";
     if (input.held) out << ", " << input.held << " held";
   }
   return out.str();

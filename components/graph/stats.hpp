@@ -16,10 +16,11 @@ namespace mocap::graph {
 
 // The synchroniser of a node with joined inputs (graph/synchronizer.hpp).
 struct SyncInputStats {
-  std::string name;            // the input ("people3d", "view:2"); set by the runtime
-  std::uint64_t received = 0;  // messages (not end of stream) taken in
-  std::uint64_t missing = 0;   // sets passed on without a message of this input
-  std::uint64_t late = 0;      // messages that came after their set had gone on (passed alone)
+  std::string name;                // the input ("people3d", "view:2"); set by the runtime
+  std::uint64_t received = 0;      // messages (not end of stream) taken in
+  std::uint64_t missing = 0;       // sets passed on without a message of this input
+  std::uint64_t late = 0;          // messages that came after their set had gone on
+  std::uint64_t late_dropped = 0;  // of those, dropped (sync_late: drop) rather than passed alone
   std::size_t held = 0, max_held = 0;
   bool ended = false;
 

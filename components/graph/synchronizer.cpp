@@ -44,14 +44,18 @@ void Synchronizer::push(std::size_t index, Packet packet, Clock::time_point now)
   if (input.last_key && key < *input.last_key) restart();  // the stream went back
   input.last_key = key;
   if (input.late_to && key <= *input.late_to) {
-    // Its set went on without it (a wait limit or the bound): passed on alone, counted.
+    // Its set went on without it (a wait limit or the bound): counted, passed on alone or dropped.
+    ++stats.late;
+    if (options_.late == LateMessages::drop) {
+      ++stats.late_dropped;
+      return;
+    }
     SyncSet set;
     set.packets.resize(inputs_.size());
     set.packets[index] = std::move(packet);
     set.key = key;
     set.late = true;
     ready_.push_back(std::move(set));
-    ++stats.late;
     ++stats_.sets;
     return;
   }

@@ -15,9 +15,11 @@
 //    (live sources that stall);
 //  * partial, at the bound (AtBound::pass_partial): an input holds `bound` messages and the oldest
 //    set still waits for another input.
-// A message that arrives after its set went on partial is passed on alone, marked late (counted
-// per input). A message older than its input's previous one (a restarted stream) passes on
-// everything held as it is and starts joining afresh (counted as a restart).
+// A message that arrives after its set went on partial is counted late (per input) and, by the
+// options' `late`, passed on alone, marked late, or dropped (a node making one output per set
+// would otherwise make a second one for that frame). A message older than its input's previous one
+// (a restarted stream) passes on everything held as it is and starts joining afresh (counted as a
+// restart).
 //
 // Memory: each input holds at most `bound` messages. With AtBound::wait a full input is simply
 // not read (readable() is false), so a blocking edge into it fills and its producer waits:
@@ -50,6 +52,7 @@ struct SyncOptions {
   std::chrono::nanoseconds wait{0};  // a set waiting this long goes on partial; 0: no limit
   std::size_t bound = 64;            // messages held per input at most (at least 1)
   AtBound at_bound = AtBound::wait;
+  LateMessages late = LateMessages::pass;
 };
 
 struct SyncSet {

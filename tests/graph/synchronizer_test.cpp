@@ -233,6 +233,28 @@ TEST(Synchronizer, AWallClockWaitLimitPassesAStalledSetOnAndItsLatePartAlone) {
   EXPECT_EQ(sync.stats().inputs[1].late, 1u);
 }
 
+TEST(Synchronizer, LateMessagesDropIsCountedAndNothingIsPassedTwiceForAFrame) {
+  // A node making one output per set (multiview.reconstruct) drops a view that comes after its
+  // set went on: frame 0 is passed on once, partial; the late view is counted, not passed alone.
+  SyncOptions options;
+  options.wait = 50ms;
+  options.late = LateMessages::drop;
+  Synchronizer sync(2, options);
+  const auto t0 = Clock::now();
+  sync.push(0, message(0), t0);
+  EXPECT_EQ(drain(sync, t0 + 50ms), Sets{"0:0"});
+  sync.push(1, message(0), t0 + 60ms);  // its set went on without it
+  sync.push(0, message(1), t0 + 60ms);
+  sync.push(1, message(1), t0 + 60ms);
+  EXPECT_EQ(drain(sync, t0 + 60ms), Sets{"1:01"});
+  const SyncStats stats = sync.stats();
+  EXPECT_EQ(stats.sets, 2u);
+  EXPECT_EQ(stats.inputs[1].late, 1u);
+  EXPECT_EQ(stats.inputs[1].late_dropped, 1u);
+  EXPECT_NE(format_sync_stats(stats).find("1 late (1 dropped)"), std::string::npos)
+      << format_sync_stats(stats);
+}
+
 TEST(Synchronizer, ARestartedStreamPassesOnWhatIsHeldAndJoinsAfresh) {
   Synchronizer sync(2, {});
   const auto now = Clock::now();

@@ -10,6 +10,7 @@
 #include <map>
 #include <random>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -214,6 +215,35 @@ TEST(MultiViewNode, LiveFitGivesConstantBonesCloserToTheTruthOneOutputPerSetInOr
   EXPECT_GT(results[0].worst_bone_std_m, 0.005);   // 4 px of noise: triangulated bones vary
   EXPECT_LT(results[1].worst_bone_std_m, 0.0001);  // fitted: one skeleton per track
   EXPECT_LT(results[1].mean_error_m, results[0].mean_error_m);
+}
+
+TEST(MultiViewNode, AViewLaterThanItsSetIsCountedAndDroppedNotSolvedAsASecondSet) {
+  MOCAP_REQUIRE_SCENE_CLIPS();
+  // Live: camera 1's detector is more than sync_wait_ms late with frame 0. Set 0 goes on partial;
+  // the late view must not make a second People3D of frame 0 (poses.jsonl keeps one line per
+  // frame number): it is counted late and dropped.
+  using namespace std::chrono_literals;
+  Fixture fx;
+  graph::Harness node("multiview.reconstruct",
+                      {{"rig", fx.rig_file}, {"sync_wait_ms", "30"}, {"report_tentative", "true"}},
+                      views(2));
+  node.push("view", project(fx.rig.cameras[0], fx.people, 0), 0);
+  EXPECT_EQ(node.process_ready(), 0u);  // taken in: set 0 waits for view 1
+  std::this_thread::sleep_for(60ms);
+  EXPECT_EQ(node.process_ready(), 1u);  // set 0, partial: its wait is over
+  node.push("view", project(fx.rig.cameras[1], fx.people, 0), 1);  // late
+  for (int f = 1; f < 4; ++f)
+    for (std::size_t c = 0; c < 2; ++c)
+      node.push("view", project(fx.rig.cameras[c], fx.people, f), c);
+  node.finish();
+  std::vector<std::int64_t> frames;
+  for (const auto& out : node.pull<People3D>("out")) frames.push_back(out->header.frame);
+  EXPECT_EQ(frames, (std::vector<std::int64_t>{0, 1, 2, 3}));
+  const auto sync = node.stats().sync;
+  EXPECT_EQ(sync.sets, 4u);
+  EXPECT_EQ(sync.complete, 3u);
+  EXPECT_EQ(sync.inputs[1].late, 1u);
+  EXPECT_EQ(sync.inputs[1].late_dropped, 1u);
 }
 
 TEST(MultiViewNode, AFitModeItDoesNotKnowIsRefusedByGraphValidation) {

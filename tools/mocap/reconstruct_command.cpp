@@ -447,6 +447,14 @@ json node_latency(const graph::GraphStats& stats) {
   for (const auto& n : stats.nodes) {
     nodes[n.node] = {{"type", n.type},   {"in", n.in},         {"out", n.out},
                      {"drops", n.drops}, {"p50_us", n.p50_us}, {"p95_us", n.p95_us}};
+    if (n.sync.inputs.empty()) continue;
+    // A joined node: its sets, and the messages that came after their set went on.
+    std::uint64_t late = 0, late_dropped = 0;
+    for (const auto& input : n.sync.inputs) late += input.late, late_dropped += input.late_dropped;
+    nodes[n.node]["sync"] = {{"sets", n.sync.sets},
+                             {"complete", n.sync.complete},
+                             {"late", late},
+                             {"late_dropped", late_dropped}};
   }
   return nodes;
 }

@@ -27,7 +27,9 @@ class MultiViewReconstructNode : public Node {
     c.inputs<People2D>("view", "one camera's people (its `camera` names it as the rig does)", 1,
                        multiview::kMaxViews);
     c.output<People3D>("out", "people in the rig's world: track ids, 15 joints in metres");
-    c.join({{"view"}, SyncKey::frame, 64});
+    // One output per set: a view that comes after its set went on (sync_wait_ms) is counted and
+    // dropped, not solved alone as a second set of the same frame.
+    c.join({{"view"}, SyncKey::frame, 64, 0.0, 0.0, LateMessages::drop});
     c.required_param<std::string>("rig", "rig file: Pose2Sim/anipose TOML or OpenCV YAML");
     declare_reconstruction_params(c);  // volume, fps, report_tentative
     declare_multiview_fit_params(c);   // fit, lag, bone_frames, window, overlap, max_missed
