@@ -29,6 +29,22 @@ struct ViewKeypoints {
       keypoints{};  // 15 × (x, y, confidence), undistorted pixels; confidence 0 = missing
 };
 
+// Bone directions the fit is drawn towards besides the views (the monocular retrieval's,
+// monocular_prior.hpp): per bone b (ending at joint b, b < 14), a unit direction in the world and
+// the inverse of its sigma in radians (0: no term for that bone).
+struct DirectionPrior {
+  std::array<glm::vec3, kBodyJoints - 1> direction{};
+  std::array<float, kBodyJoints - 1> inv_sigma{};
+  // The bone's reference (start, and the fit's own weak direction prior) is this direction
+  // instead of the triangulated one: where the views do not fix the bone.
+  std::array<bool, kBodyJoints - 1> reference{};
+  bool any() const {
+    for (const float w : inv_sigma)
+      if (w > 0.0f) return true;
+    return false;
+  }
+};
+
 // One frame of one person.
 struct MultiViewFrameInput {
   std::vector<ViewKeypoints> views;  // none: the person was not seen (filled by smoothness)
@@ -36,6 +52,7 @@ struct MultiViewFrameInput {
   // multiview::FrameResult::body_of. The frame is fitted when its root is triangulated.
   Body triangulated = not_triangulated();
   std::array<bool, 2> contact{};  // right, left ankle in contact with the floor (kFeet order)
+  DirectionPrior prior;           // none by default; a bone never triangulated also starts from it
 
   static Body not_triangulated();
 };
