@@ -26,7 +26,7 @@ struct MonocularPriorOptions {
   // One sigma (radians, about: the residual is the chord between unit directions) of a fitted
   // bone direction away from the retrieved one, by how well the views fix the bone's two joints.
   // Chosen on HumanEva-I Train (docs/multiview.md "The monocular prior").
-  double few_views_rad = 0.25;  // an end from < 2 views, rays too parallel, or a large error
+  double few_views_rad = 0.1;   // an end from < 2 views, or its depth uncertain
   double two_views_rad = 1.0;   // both ends from two views at a good angle
   double many_views_rad = 3.0;  // both ends from 3+ views that agree; <= 0: no term
   // A point from two views or more is trusted when its depth is known to this (metres): its mean

@@ -142,12 +142,12 @@ TEST(MonocularPrior, GivesDepthToAJointSeenByOneCamera) {
             << " mm, monocular prior " << prior_mm << " mm, prior at the wrong depth " << flipped_mm
             << " mm\n";
   // Without a prior the arm's depth is a guess (30 cm off); the prior, retrieved from a small
-  // database of three clips, puts it within 10 cm.
-  EXPECT_GT(without_mm, 100.0);
-  EXPECT_LT(prior_mm, 100.0);
-  EXPECT_LT(prior_mm, 0.5 * without_mm);
+  // database of three clips, puts it within 12 cm (96 mm measured).
+  EXPECT_GT(without_mm, 200.0);
+  EXPECT_LT(prior_mm, 120.0);
+  EXPECT_LT(prior_mm, 0.4 * without_mm);
   // The prior decides: turned to the other depth, the arm follows it (the test can fail).
-  EXPECT_GT(flipped_mm, 2.0 * prior_mm);
+  EXPECT_GT(flipped_mm, prior_mm + 100.0);
 }
 
 TEST(MonocularPrior, WeighsABoneByHowWellTheViewsFixItsEnds) {
