@@ -350,7 +350,8 @@ int humaneva_multiview_command(int argc, char** argv) {
             "retrieval, then the monocular fit), on the\nsame chunks and frames, from the "
             "ground-truth 2D with seeded noise. MPJPE, PA-MPJPE, absolute\nMPJPE, acceleration "
             "error, bone-length std; Markdown tables and every number as JSON.");
-  args.option("db", "FILE", "pose database for the monocular rows (the CMU train split)")
+  args.option("db", "FILE",
+              "pose database for the monocular rows and the prior (the CMU train split)")
       .option("data", "DIR", "HumanEva-I in the VideoPose3D format",
               "../shared/data/eval/humaneva_i_videopose3d")
       .option("json", "FILE", "where to write all numbers", "eval_humaneva_multiview.json")
