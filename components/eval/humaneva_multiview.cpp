@@ -130,8 +130,16 @@ TakeReconstruction reconstruct_take(const HumanEvaTake& take,
     fit_options.cameras = rig;
     fit_options.fit = fit::multiview_fit_defaults();
     fit_options.fit.ground = take.floor;
+    std::vector<multiview::FrameResult> triangulated;
+    if (options.prior_db) triangulated = results;  // the prior's fit starts from these too
     fit::fit_tracks(observations, results, fit_options, /*live=*/false);
     out.fitted = subject_poses(results, nullptr, nullptr);
+    if (options.prior_db) {
+      fit::MonocularPrior prior(*options.prior_db, options.prior);
+      fit::fit_tracks(observations, triangulated, fit_options, /*live=*/false,
+                      multiview::KeypointSet::body15(), &prior);
+      out.fitted_prior = subject_poses(triangulated, nullptr, nullptr);
+    }
   }
   return out;
 }

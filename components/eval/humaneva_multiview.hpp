@@ -20,6 +20,7 @@
 #include "core/ground_plane.hpp"
 #include "eval/humaneva_protocol.hpp"
 #include "eval/multiview_scene.hpp"
+#include "fit/monocular_prior.hpp"
 #include "multiview/reconstructor.hpp"
 
 namespace mocap::eval {
@@ -45,6 +46,10 @@ struct HumanEvaMultiviewOptions {
   multiview::ReconstructionOptions reconstruction;
   double fps = 24.0;
   bool fit = true;  // also fit_multiview_sequence (full mode) on the tracks
+  // With fit: also the fit with the monocular retrieval's prior (fit::MonocularPrior) from this
+  // database (none: no such row).
+  const posedb::Database* prior_db = nullptr;
+  fit::MonocularPriorOptions prior;
 };
 
 // One take reconstructed from some cameras. Poses are in HumanEva's world (the rig's), valid
@@ -53,6 +58,7 @@ struct HumanEvaMultiviewOptions {
 struct TakeReconstruction {
   std::vector<recon::Pose3D> triangulated;  // tracking on (the library's default)
   std::vector<recon::Pose3D> fitted;        // empty without options.fit
+  std::vector<recon::Pose3D> fitted_prior;  // + the monocular prior; empty without prior_db
   long extra_people = 0;                    // people reported besides the one scored, summed
   long partial_frames = 0;                  // frames whose person missed a joint
 };

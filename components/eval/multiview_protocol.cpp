@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <iomanip>
+#include <optional>
 #include <sstream>
 
 #include <glm/geometric.hpp>
@@ -88,12 +89,15 @@ std::string_view method_label(MultiviewMethod method) {
       return "(iv) + skeleton fit, full";
     case MultiviewMethod::skeleton_fit_live:
       return "(iv) + skeleton fit, live";
+    case MultiviewMethod::skeleton_fit_prior:
+      return "(iv) + skeleton fit + monocular prior, full";
   }
   return "?";
 }
 
 bool fits_skeleton(MultiviewMethod method) {
-  return method == MultiviewMethod::skeleton_fit || method == MultiviewMethod::skeleton_fit_live;
+  return method == MultiviewMethod::skeleton_fit || method == MultiviewMethod::skeleton_fit_live ||
+         method == MultiviewMethod::skeleton_fit_prior;
 }
 
 std::vector<TruthSequence> load_heldout_clips(const std::string& cmu_folder, double fps) {
@@ -194,9 +198,11 @@ std::vector<MultiviewResult> run_multiview_case(const std::vector<TruthSequence>
   std::vector<multiview::FrameResult> tracked;
   double tracked_cpu_s = 0.0;
   std::vector<MultiviewResult> out;
-  for (const MultiviewMethod method :
-       {MultiviewMethod::pose2sim_rule, MultiviewMethod::per_frame, MultiviewMethod::tracking,
-        MultiviewMethod::skeleton_fit, MultiviewMethod::skeleton_fit_live}) {
+  std::vector<MultiviewMethod> methods = {
+      MultiviewMethod::pose2sim_rule, MultiviewMethod::per_frame, MultiviewMethod::tracking,
+      MultiviewMethod::skeleton_fit, MultiviewMethod::skeleton_fit_live};
+  if (options.prior_db) methods.push_back(MultiviewMethod::skeleton_fit_prior);
+  for (const MultiviewMethod method : methods) {
     MultiviewResult r;
     r.scene = scene;
     r.method = method;
@@ -204,8 +210,11 @@ std::vector<MultiviewResult> run_multiview_case(const std::vector<TruthSequence>
     if (fits_skeleton(method)) {
       std::vector<multiview::FrameResult> results = tracked;
       const double start = thread_cpu_s();
+      std::optional<fit::MonocularPrior> prior;
+      if (method == MultiviewMethod::skeleton_fit_prior) prior.emplace(*options.prior_db);
       fit::fit_tracks(std::span(input).first(results.size()), results, fit_options,
-                      method == MultiviewMethod::skeleton_fit_live);
+                      method == MultiviewMethod::skeleton_fit_live,
+                      multiview::KeypointSet::body15(), prior ? &*prior : nullptr);
       r.cpu_s = tracked_cpu_s + thread_cpu_s() - start;
       r.frames = static_cast<long>(results.size());
       for (std::size_t f = 0; f < results.size(); ++f) scorer.add(frames[f], results[f]);

@@ -22,12 +22,20 @@
 
 #include "eval/multiview_scene.hpp"
 #include "eval/virtual_protocol.hpp"
+#include "posedb/database.hpp"
 
 namespace mocap::eval {
 
-enum class MultiviewMethod { pose2sim_rule, per_frame, tracking, skeleton_fit, skeleton_fit_live };
+enum class MultiviewMethod {
+  pose2sim_rule,
+  per_frame,
+  tracking,
+  skeleton_fit,
+  skeleton_fit_live,
+  skeleton_fit_prior  // full, + the monocular retrieval's prior (fit::MonocularPrior)
+};
 std::string_view method_label(MultiviewMethod method);
-bool fits_skeleton(MultiviewMethod method);  // skeleton_fit or skeleton_fit_live
+bool fits_skeleton(MultiviewMethod method);  // skeleton_fit, skeleton_fit_live or _prior
 
 struct MultiviewCase {
   int views = 4;
@@ -46,6 +54,9 @@ struct MultiviewProtocolOptions {
   // take seconds per frame set at 16 views; the frames it got through are reported.
   double budget_s = 60.0;
   std::uint64_t seed = 1;
+  // A pose database (the CMU train split): adds (iv) + skeleton fit + monocular prior, full mode,
+  // the prior retrieved from it with fit::MonocularPrior's defaults.
+  const posedb::Database* prior_db = nullptr;
 };
 
 struct MultiviewResult {

@@ -112,13 +112,29 @@ FrameData frame_data(const MultiViewFrameInput& in, const Directions& directions
   d.start_t = {root.x, root.y, root.z};
   d.views.reserve(in.views.size());
   for (const ViewKeypoints& v : in.views) d.views.push_back(view_data(v, options));
+  for (int b = 0; b < kBones; ++b) {
+    const glm::vec3& p = in.prior.direction[b];
+    const double w = in.prior.inv_sigma[b], len = glm::length(glm::dvec3(p));
+    if (!(w > 0.0) || !(len > 0.5) || !std::isfinite(len)) continue;
+    d.prior_d[b] = {p.x / len, p.y / len, p.z / len};
+    d.prior_inv_sigma[b] = w;
+  }
   return d;
 }
 
-// Directions of a frame: the triangulated ones, the others from `known` (updated).
-Directions directions_of(const Body& triangulated, Directions& known) {
-  for (int b = 0; b < kBones; ++b)
-    if (const auto d = bone_direction(triangulated, b)) known[b] = *d;
+// Directions of a frame: the triangulated ones, else (or where the prior says so) the prior's
+// (the monocular retrieval), the others from `known` (updated).
+Directions directions_of(const MultiViewFrameInput& in, Directions& known) {
+  for (int b = 0; b < kBones; ++b) {
+    const auto d = bone_direction(in.triangulated, b);
+    if (d && !in.prior.reference[b]) {
+      known[b] = *d;
+    } else if (in.prior.inv_sigma[b] > 0.0f) {
+      const glm::dvec3 p = glm::normalize(glm::dvec3(in.prior.direction[b]));
+      if (std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z))
+        known[b] = {p.x, p.y, p.z};
+    }
+  }
   return known;
 }
 
@@ -174,8 +190,7 @@ FitResult fit_multiview_sequence(std::span<const MultiViewFrameInput> frames,
   for (std::size_t i = n; i-- > 0;)  // backwards: the first seen direction of each bone
     for (int b = 0; b < kBones; ++b)
       if (const auto d = bone_direction(frames[first + i].triangulated, b)) known[b] = *d;
-  for (std::size_t i = 0; i < n; ++i)
-    directions[i] = directions_of(frames[first + i].triangulated, known);
+  for (std::size_t i = 0; i < n; ++i) directions[i] = directions_of(frames[first + i], known);
 
   std::vector<FrameData> data(n);
   std::vector<FrameVars> vars(n);
@@ -414,7 +429,7 @@ const FitStats& MultiViewLiveFitter::stats() const { return state_->stats; }
 std::vector<FittedFrame> MultiViewLiveFitter::push(const MultiViewFrameInput& frame) {
   State& s = *state_;
   const bool obs = observed(frame);
-  FrameData d = frame_data(frame, directions_of(frame.triangulated, s.known), s.options);
+  FrameData d = frame_data(frame, directions_of(frame, s.known), s.options);
   FrameVars v;
   if (obs) s.last_t = d.start_t;
   if (s.last_t) v.t = obs || s.vars.empty() ? *s.last_t : s.vars.back().t;

@@ -30,6 +30,22 @@ struct ViewKeypoints {
       keypoints{};  // 15 × (x, y, confidence), undistorted pixels; confidence 0 = missing
 };
 
+// Bone directions the fit is drawn towards besides the views (the monocular retrieval's,
+// monocular_prior.hpp): per bone b (ending at joint b, b < 14), a unit direction in the world and
+// the inverse of its sigma in radians (0: no term for that bone).
+struct DirectionPrior {
+  std::array<glm::vec3, kBodyJoints - 1> direction{};
+  std::array<float, kBodyJoints - 1> inv_sigma{};
+  // The bone's reference (start, and the fit's own weak direction prior) is this direction
+  // instead of the triangulated one: where the views do not fix the bone.
+  std::array<bool, kBodyJoints - 1> reference{};
+  bool any() const {
+    for (const float w : inv_sigma)
+      if (w > 0.0f) return true;
+    return false;
+  }
+};
+
 // One frame of one person.
 struct MultiViewFrameInput {
   std::vector<ViewKeypoints> views;  // none: the person was not seen (filled by smoothness)
@@ -41,6 +57,7 @@ struct MultiViewFrameInput {
   // its sets with gaps where it dropped some): the smoothness terms take a gap of k periods as k
   // steps. NaN: one period after the frame before it.
   double time = std::numeric_limits<double>::quiet_NaN();
+  DirectionPrior prior;  // none by default; a bone never triangulated also starts from it
 
   static Body not_triangulated();
 };

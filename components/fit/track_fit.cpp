@@ -10,7 +10,7 @@ namespace mocap::fit {
 TrackFits fit_tracks(std::span<const multiview::FrameObservations> input,
                      std::vector<multiview::FrameResult>& results,
                      const MultiViewFitOptions& options, bool live,
-                     const multiview::KeypointSet& set) {
+                     const multiview::KeypointSet& set, MonocularPrior* prior) {
   // Each track's (frame, person) in frame order.
   std::map<int, std::vector<std::pair<std::size_t, std::size_t>>> tracks;
   for (std::size_t f = 0; f < results.size() && f < input.size(); ++f)
@@ -20,8 +20,11 @@ TrackFits fit_tracks(std::span<const multiview::FrameObservations> input,
   for (const auto& [id, seen] : tracks) {
     const std::size_t first = seen.front().first, last = seen.back().first;
     std::vector<MultiViewFrameInput> frames(last + 1 - first);
-    for (const auto& [f, p] : seen)
-      multiview_input(input[f], results[f], p, set, frames[f - first]);
+    for (const auto& [f, p] : seen) {
+      MultiViewFrameInput& frame = frames[f - first];
+      multiview_input(input[f], results[f], p, set, frame);
+      if (prior && prior->add(frame, results[f].body_of(p), options.cameras)) ++out.prior_frames;
+    }
     std::vector<FittedFrame> fitted;
     if (live) {
       MultiViewLiveFitter fitter(options);

@@ -8,6 +8,7 @@
 #include <span>
 #include <vector>
 
+#include "fit/monocular_prior.hpp"
 #include "fit/multiview_fit.hpp"
 #include "multiview/observations.hpp"
 #include "multiview/reconstructor.hpp"
@@ -17,6 +18,7 @@ namespace mocap::fit {
 struct TrackFits {
   long tracks = 0;
   long person_frames = 0;  // fitted bodies written
+  long prior_frames = 0;   // person-frames with a monocular prior
   FitStats stats;
 };
 
@@ -24,10 +26,13 @@ struct TrackFits {
 // people with id -1 are left as they are), live (MultiViewLiveFitter, one per track, frames
 // pushed in order, a frame the track missed pushed empty) or full (fit_multiview_sequence per
 // track), and replaces each fitted person's 15 body points by the fitted joints. `set`: how the
-// input's keypoints make the 15 body joints.
+// input's keypoints make the 15 body joints. `prior` (optional): each person-frame also gets the
+// monocular retrieval's bone directions (monocular_prior.hpp), weighted by how well the views fix
+// each bone; `options.cameras` must then be the views' cameras.
 TrackFits fit_tracks(std::span<const multiview::FrameObservations> input,
                      std::vector<multiview::FrameResult>& results,
                      const MultiViewFitOptions& options, bool live,
-                     const multiview::KeypointSet& set = multiview::KeypointSet::body15());
+                     const multiview::KeypointSet& set = multiview::KeypointSet::body15(),
+                     MonocularPrior* prior = nullptr);
 
 }  // namespace mocap::fit

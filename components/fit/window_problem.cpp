@@ -106,6 +106,21 @@ struct PriorCost {
   }
 };
 
+// A bone's direction exp(w) · d0 away from a direction from elsewhere (the monocular retrieval):
+// the chord between the two unit vectors, about the angle when small, at most 2 (a retrieval
+// pointing the other way pulls with a bounded force).
+struct DirectionCost {
+  std::array<double, 3> d0, target;
+  double inv_sigma;
+  template <typename T>
+  bool operator()(const T* w, T* r) const {
+    T d[3];
+    bone_direction(w, d0, d);
+    for (int k = 0; k < 3; ++k) r[k] = (d[k] - T(target[k])) * T(inv_sigma);
+    return true;
+  }
+};
+
 // Second difference of one bone vector in the world (three frames): c = (1, -2, 1); or, with
 // c = (0, -1, 1), the first difference of the last two.
 using Difference = std::array<double, 3>;
@@ -401,6 +416,17 @@ WindowSummary solve_window(std::span<const WindowFrame> frames, Bones& bones,
                                    std::make_unique<PriorCost>(PriorCost{prior}).release())
                                    .release(),
                                nullptr, v.w[b].data());
+    // Directions from elsewhere (multi-view: the monocular prior).
+    if (d.observed)
+      for (int b = 0; b < kBones; ++b)
+        if (d.prior_inv_sigma[b] > 0.0)
+          problem.AddResidualBlock(
+              std::make_unique<ceres::AutoDiffCostFunction<DirectionCost, 3, 3>>(
+                  std::make_unique<DirectionCost>(
+                      DirectionCost{d.d0[b], d.prior_d[b], d.prior_inv_sigma[b]})
+                      .release())
+                  .release(),
+              nullptr, v.w[b].data());
     // Knees.
     for (const auto& [knee, ankle] :
          {std::pair{index(Joint::right_knee), index(Joint::right_ankle)},

@@ -59,6 +59,10 @@ struct FrameData {
   // Multi-view: every camera that saw the person (the variables are then in the world and the
   // single-camera keypoints above are unused: sigma_px 0). Empty for the monocular fit.
   std::vector<ViewData> views;
+  // Multi-view: bone directions from elsewhere (the monocular retrieval, unit, world) and their
+  // inverse sigmas (0: no term).
+  std::array<std::array<double, 3>, kBones> prior_d{};
+  std::array<double, kBones> prior_inv_sigma{};
 };
 
 using Bones = std::array<double, kBones>;

@@ -43,20 +43,55 @@ constexpr const char* kMonocularConfig = "full: path + SG + ray + view";
 struct Row {
   std::vector<int> cameras;  // one: monocular
   bool fitted = false;
+  bool prior = false;  // several cameras, fitted: with the monocular prior
   std::string input() const { return eval::cameras_label(cameras); }
   std::string method() const {
     if (cameras.size() == 1) return fitted ? "monocular + fit (full)" : "monocular retrieval";
+    if (prior) return "triangulation + tracking + fit + monocular prior (full)";
     return fitted ? "triangulation + tracking + fit (full)" : "triangulation + tracking";
   }
 };
 
-std::vector<Row> make_rows(bool fit) {
+std::vector<Row> make_rows(bool fit, bool prior, bool monocular) {
   std::vector<Row> rows;
   const std::vector<std::vector<int>> sets = {{0}, {1}, {2}, {0, 1}, {0, 2}, {1, 2}, {0, 1, 2}};
-  for (const auto& set : sets)
+  for (const auto& set : sets) {
+    if (set.size() == 1 && !monocular) continue;
     for (const bool fitted : {false, true})
       if (!fitted || fit) rows.push_back({set, fitted});
+    if (fit && prior && set.size() > 1) rows.push_back({set, true, true});
+  }
   return rows;
+}
+
+// `--prior-set NAME=VALUE`: a setting of the monocular prior (fit::MonocularPriorOptions), for
+// choosing them on --split train.
+void set_prior_option(fit::MonocularPriorOptions& o, const std::string& assignment) {
+  const auto eq = assignment.find('=');
+  if (eq == std::string::npos) throw InputError("--prior-set " + assignment, "expected NAME=VALUE");
+  const std::string name = assignment.substr(0, eq);
+  double value = 0.0;
+  try {
+    value = std::stod(assignment.substr(eq + 1));
+  } catch (const std::exception&) {
+    throw InputError("--prior-set " + assignment, "the value is not a number");
+  }
+  const std::map<std::string, double*> settings = {{"few_views_rad", &o.few_views_rad},
+                                                   {"two_views_rad", &o.two_views_rad},
+                                                   {"many_views_rad", &o.many_views_rad},
+
+                                                   {"max_depth_error_m", &o.max_depth_error_m}};
+  if (name == "few_views_reference") {
+    o.few_views_reference = value != 0.0;
+    return;
+  }
+  const auto found = settings.find(name);
+  if (found == settings.end())
+    throw InputError("--prior-set " + assignment,
+                     "unknown setting " + name +
+                         " (few_views_rad, two_views_rad, many_views_rad, "
+                         "max_depth_error_m, few_views_reference)");
+  *found->second = value;
 }
 
 // Poses of a monocular fit in the camera frame, placed (absolute joints).
@@ -146,15 +181,17 @@ struct Evaluation {
   fit::FitOptions mono_fit;
   eval::HumanEvaMultiviewOptions multiview;
   bool fit = true;
+  bool monocular = true;  // the single-camera rows
   std::vector<eval::HumanEvaSequence> sequences;
   std::vector<eval::HumanEvaTake> takes;
   std::vector<eval::Condition> conditions;
   std::vector<Row> rows;
   std::vector<std::vector<int>> sets;  // the several-camera sets, in row order
 
-  std::size_t row(const std::vector<int>& cameras, bool fitted) const {
+  std::size_t row(const std::vector<int>& cameras, bool fitted, bool prior = false) const {
     for (std::size_t i = 0; i < rows.size(); ++i)
-      if (rows[i].cameras == cameras && rows[i].fitted == fitted) return i;
+      if (rows[i].cameras == cameras && rows[i].fitted == fitted && rows[i].prior == prior)
+        return i;
     throw std::logic_error("no row " + eval::cameras_label(cameras));
   }
   // Camera c's 2D of a take with the monocular protocol's noise and seed (mocap eval humaneva).
@@ -191,7 +228,8 @@ Poses run_jobs(const Evaluation& e, int threads, Counts& counts) {
   std::vector<Job> jobs;
   for (std::size_t n = 0; n < e.conditions.size(); ++n)
     for (std::size_t t = 0; t < e.takes.size(); ++t) {
-      for (int c = 0; c < he::kCameras; ++c) jobs.push_back({n, t, c, 0});
+      if (e.monocular)
+        for (int c = 0; c < he::kCameras; ++c) jobs.push_back({n, t, c, 0});
       for (std::size_t s = 0; s < e.sets.size(); ++s) jobs.push_back({n, t, -1, s});
     }
   Poses poses(e.conditions.size(),
@@ -214,6 +252,7 @@ Poses run_jobs(const Evaluation& e, int threads, Counts& counts) {
             eval::reconstruct_take(e.takes[job.take], e.sequences, inputs, set, e.multiview);
         out[e.row(set, false)] = r.triangulated;
         if (e.fit) out[e.row(set, true)] = r.fitted;
+        if (e.fit && e.multiview.prior_db) out[e.row(set, true, true)] = r.fitted_prior;
         const std::lock_guard lock(counts_mutex);
         counts.extra_people[job.condition][job.set] += r.extra_people;
         counts.partial_frames[job.condition][job.set] += r.partial_frames;
@@ -252,11 +291,12 @@ std::vector<Totals> score_rows(const Evaluation& e, const Poses& poses, std::siz
 }
 
 // The rows of one camera (count 1) or of one pair (count 2) at a stage, added up.
-Totals pooled(const Evaluation& e, const std::vector<Totals>& totals, bool fitted,
+Totals pooled(const Evaluation& e, const std::vector<Totals>& totals, bool fitted, bool prior,
               std::size_t count) {
   Totals sum;
   for (std::size_t r = 0; r < e.rows.size(); ++r) {
-    if (e.rows[r].fitted != fitted || e.rows[r].cameras.size() != count) continue;
+    if (e.rows[r].fitted != fitted || e.rows[r].prior != prior || e.rows[r].cameras.size() != count)
+      continue;
     sum.all.add(totals[r].all);
     for (const auto& [a, s] : totals[r].per_action) sum.per_action[a].add(s);
     sum.frames += totals[r].frames;
@@ -278,12 +318,14 @@ json print_table(const Evaluation& e, const std::vector<Totals>& totals, const s
     per_row[row.input() + ", " + row.method()] = totals_json(totals[r]);
     const bool last_single = row.cameras == std::vector<int>{2};
     const bool last_pair = row.cameras == std::vector<int>{1, 2};
-    if (!(last_single || last_pair) || (e.fit && !row.fitted)) continue;
-    for (const bool fitted : {false, true}) {
-      if (fitted && !e.fit) continue;
-      const Totals sum = pooled(e, totals, fitted, row.cameras.size());
+    const bool with_prior = e.fit && e.multiview.prior_db && last_pair;
+    if (!(last_single || last_pair) || (e.fit && !row.fitted) || (with_prior && !row.prior))
+      continue;
+    for (const auto& [fitted, prior] : {std::pair{false, false}, {true, false}, {true, true}}) {
+      if ((fitted && !e.fit) || (prior && !with_prior)) continue;
+      const Totals sum = pooled(e, totals, fitted, prior, row.cameras.size());
       const std::string input = last_single ? "each of C1, C2, C3" : "each pair";
-      const std::string method = Row{row.cameras, fitted}.method();
+      const std::string method = Row{row.cameras, fitted, prior}.method();
       print_row("**" + input + "**", method, sum);
       per_row[input + ", " + method] = totals_json(sum);
     }
@@ -308,7 +350,8 @@ int humaneva_multiview_command(int argc, char** argv) {
             "retrieval, then the monocular fit), on the\nsame chunks and frames, from the "
             "ground-truth 2D with seeded noise. MPJPE, PA-MPJPE, absolute\nMPJPE, acceleration "
             "error, bone-length std; Markdown tables and every number as JSON.");
-  args.option("db", "FILE", "pose database for the monocular rows (the CMU train split)")
+  args.option("db", "FILE",
+              "pose database for the monocular rows and the prior (the CMU train split)")
       .option("data", "DIR", "HumanEva-I in the VideoPose3D format",
               "../shared/data/eval/humaneva_i_videopose3d")
       .option("json", "FILE", "where to write all numbers", "eval_humaneva_multiview.json")
@@ -318,6 +361,15 @@ int humaneva_multiview_command(int argc, char** argv) {
       .option("max-frames", "N", "frames per chunk at most, at the database rate (0 = all)", "0",
               Range::count(0, std::numeric_limits<int>::max()))
       .flag("no-fit", "triangulation and monocular retrieval only (no skeleton fits)")
+      .flag("no-monocular", "the several-camera rows only (for sweeps)")
+      .flag("no-prior", "no row + fit + monocular prior (the multi-view fit with --db's poses)")
+      .option("prior-set", "NAME=VALUE",
+              "a setting of the monocular prior (few_views_rad, two_views_rad, many_views_rad, "
+              "max_depth_error_m, few_views_reference 0/1); repeat for several",
+              std::nullopt, true)
+      .option("split", "NAME",
+              "validate (the evaluation) or train (for choosing settings; no other split)",
+              "validate")
       .flag("allow-leak",
             "evaluate even when the database holds HumanEva Validate clips (refused otherwise); "
             "the results then say so, loudly");
@@ -328,16 +380,23 @@ int humaneva_multiview_command(int argc, char** argv) {
   const auto started = std::chrono::steady_clock::now();
   const int threads = static_cast<int>(args.integer("threads"));
   const bool fit = !args.has("no-fit");
+  const bool prior = fit && !args.has("no-prior");
+  const std::string split_name = args.get("split");
+  if (split_name != "validate" && split_name != "train")
+    throw InputError("--split " + split_name, "expected validate or train");
+  const he::Split split = split_name == "train" ? he::Split::train : he::Split::validate;
   const posedb::Database db = posedb::Database::open(args.get("db"));
   LeakCheck leaks;
-  leaks.add(db.path(), humaneva_clips(db, "Validate"));
-  leaks.enforce(args.has("allow-leak"), "HumanEva-I Validate", "mocap eval humaneva-multiview");
+  const std::string split_label = split == he::Split::train ? "Train" : "Validate";
+  leaks.add(db.path(), humaneva_clips(db, split_label));
+  leaks.enforce(args.has("allow-leak"), "HumanEva-I " + split_label,
+                "mocap eval humaneva-multiview");
 
   const std::string folder = args.get("data");
   const he::Dataset data = he::load_dataset(folder);
   const auto cameras = he::load_cameras(std::filesystem::path(folder) / he::kCamerasFile);
   const double fps = db.build_info().fps;
-  auto sequences = eval::humaneva_validation_sequences(data, cameras, fps);
+  auto sequences = eval::humaneva_validation_sequences(data, cameras, fps, split);
   if (const long max = args.integer("max-frames"); max > 0)
     for (auto& s : sequences)
       if (s.input.size() > static_cast<std::size_t>(max)) {
@@ -364,11 +423,15 @@ int humaneva_multiview_command(int argc, char** argv) {
   e.mono_fit.ground = cameras.begin()->second.floor.value();  // HumanEva's world Z = 0
   e.multiview.fps = fps;
   e.multiview.fit = fit;
+  e.multiview.prior_db = prior ? &db : nullptr;
+  for (const std::string& setting : args.all("prior-set"))
+    set_prior_option(e.multiview.prior, setting);
   e.fit = fit;
   e.sequences = std::move(sequences);
   e.takes = eval::humaneva_takes(e.sequences, cameras);
   e.conditions = std::move(conditions);
-  e.rows = make_rows(fit);
+  e.monocular = !args.has("no-monocular");
+  e.rows = make_rows(fit, prior, e.monocular);
   for (const Row& r : e.rows)
     if (r.cameras.size() > 1 && !r.fitted) e.sets.push_back(r.cameras);
   Counts counts;
@@ -376,11 +439,14 @@ int humaneva_multiview_command(int argc, char** argv) {
 
   std::size_t frames = 0;
   for (const auto& take : e.takes) frames += take.truth_world.size();
-  std::cout << leaks.markdown_warning() << "## HumanEva-I Validate, several cameras and one\n\n"
+  std::cout << leaks.markdown_warning() << "## HumanEva-I " << split_label
+            << ", several cameras and one\n\n"
             << e.takes.size() << " chunks (Walk, Jog, Box; S1-S3), " << frames << " frames at "
             << fps << " fps; monocular rows: " << args.get("db") << ", configuration \""
             << kMonocularConfig << "\"; several cameras: components/multiview defaults"
-            << (fit ? ", multi-view fit full mode (multiview_fit_defaults)" : "") << "\n";
+            << (fit ? ", multi-view fit full mode (multiview_fit_defaults)" : "")
+            << (prior ? ", + monocular prior (fit::MonocularPrior) from the same database" : "")
+            << "\n";
   json results = json::object();
   for (std::size_t n = 0; n < e.conditions.size(); ++n)
     results[e.conditions[n].label()] =
@@ -397,6 +463,7 @@ int humaneva_multiview_command(int argc, char** argv) {
               {"git_commit", git_commit()},
               {"machine", machine_description()},
               {"database", args.get("db")},
+              {"split", split_label},
               {"monocular_configuration", kMonocularConfig},
               {"evaluation_fps", fps},
               {"chunks", e.takes.size()},

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <iostream>
 #include <map>
+#include <optional>
 #include <tuple>
 
 #include <nlohmann/json.hpp>
@@ -15,6 +16,7 @@
 #include "core/input_error.hpp"
 #include "eval/multiview_protocol.hpp"
 #include "eval/pose2sim_multiview.hpp"
+#include "eval_leaks.hpp"
 #include "eval_report.hpp"
 #include "output_files.hpp"
 
@@ -113,11 +115,24 @@ int multiview_eval_command(int argc, char** argv) {
       .option("budget", "S", "CPU seconds at most per method and case (frames done are shown)",
               "60", Range::between(0.1, 1e6))
       .option("seed", "N", "scene placement and degradation seed", "1", Range::count(0, 1000000000))
-      .option("json", "FILE", "where to write all numbers", "eval_multiview.json");
+      .option("json", "FILE", "where to write all numbers", "eval_multiview.json")
+      .option("db", "FILE",
+              "pose database (CMU train split): adds the row + skeleton fit + monocular prior")
+      .flag("allow-leak",
+            "with --db: evaluate even when the database holds held-out CMU clips (refused "
+            "otherwise); the results then say so, loudly");
   int code = 0;
   if (!args.parse(argc, argv, code)) return code;
   const auto started = std::chrono::steady_clock::now();
+  std::optional<posedb::Database> db;
+  LeakCheck leaks;
+  if (args.has("db")) {
+    db.emplace(posedb::Database::open(args.get("db")));
+    leaks.add(db->path(), cmu_heldout_clips(*db, args.get("mocap")));
+    leaks.enforce(args.has("allow-leak"), "the held-out CMU clips", "mocap eval multiview");
+  }
   eval::MultiviewProtocolOptions options;
+  options.prior_db = db ? &*db : nullptr;
   options.frames = static_cast<int>(args.integer("frames"));
   options.budget_s = args.number("budget");
   options.seed = static_cast<std::uint64_t>(args.integer("seed"));
@@ -132,6 +147,8 @@ int multiview_eval_command(int argc, char** argv) {
               {"dropout", options.dropout},
               {"outliers", options.outliers},
               {"false_detections", options.false_detections},
+              {"database", db ? json(args.get("db")) : json(nullptr)},
+              {"leak", leaks.to_json()},
               {"results", json::array()}};
   for (const auto& c : clips)
     out["clips"].push_back({{"clip", c.clip}, {"frames", c.world.size()}});
@@ -145,7 +162,8 @@ int multiview_eval_command(int argc, char** argv) {
     }
   }
   std::cerr << "\n";
-  std::cout << "## Multi-view, virtual scenes of the held-out CMU clips\n\n"
+  std::cout << leaks.markdown_warning()
+            << "## Multi-view, virtual scenes of the held-out CMU clips\n\n"
             << options.frames << " frame sets at 30 fps per case; 10 % joints dropped, 5 % "
             << "outlier keypoints, false detections (20 % of views and frames), occlusion; "
                "1920x1080 cameras on a 6 m ring (2 and 3 cameras 90 degrees apart). MPJPE in "
