@@ -263,7 +263,7 @@ struct MultiViewWindowedFitter::State {
       std::vector<WindowFrame> problem;
       anchors.add_to(problem);
       for (std::size_t i = 0; i <= last; ++i) {
-        directions_of(inputs[i].triangulated, directions);
+        directions_of(inputs[i], directions);
         if (i < first) continue;
         if (!warm[i]) {
           data[i] = frame_data(inputs[i], directions, options);
