@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <functional>
 #include <iostream>
+#include <regex>
 #include <thread>
 
 #include <nlohmann/json.hpp>
@@ -224,7 +225,16 @@ TEST_F(RigLiveSync, ReconstructTakesCamerasAsViewsUntilCtrlC) {
                         &solved_complete),
             2)
       << err;
-  EXPECT_EQ(solved_complete, complete) << err;
+  // A detector later than the join's sync_wait_ms (a loaded machine, a sanitizer build) has its
+  // view dropped and counted, so its set is solved without it: complete, less those.
+  unsigned long long late_dropped = 0;
+  const std::string solve_line = err.substr(solve, err.find('\n', solve) - solve);
+  const std::regex dropped_views(R"(late \((\d+) dropped\))");
+  for (std::sregex_iterator it(solve_line.begin(), solve_line.end(), dropped_views), end; it != end;
+       ++it)
+    late_dropped += std::stoull((*it)[1]);
+  EXPECT_LE(solved_complete, complete) << err;
+  EXPECT_GE(solved_complete + late_dropped, complete) << err;
   EXPECT_LE(solved, passed) << err;  // those the drain let through
   EXPECT_GE(solved + 2, passed) << err;
 }
