@@ -76,8 +76,11 @@ std::optional<StampedFrame> Playback::next(const WaitUntil& wait) {
       lose_stream();
       return std::nullopt;
     }
-    undecodable_ +=
-        static_cast<std::uint64_t>(std::max<std::int64_t>(0, source_.frames_undecodable()));
+    if (const auto undecodable = source_.frames_undecodable(); undecodable > 0) {
+      undecodable_ += static_cast<std::uint64_t>(undecodable);
+      add_news(std::to_string(undecodable) + " corrupt frames skipped in " + source_.source() +
+               " (" + std::to_string(undecodable_) + " so far)");
+    }
     if (!start_next_pass()) return std::nullopt;
   }
 }
@@ -104,10 +107,10 @@ void Playback::lose_stream() {
   attempts_ = 0;
   ++losses_;
   index_base_ += source_.frames_read();
-  news_ += "lost " + path_ + " after " + std::to_string(index_base_) +
+  add_news("lost " + path_ + " after " + std::to_string(index_base_) +
            " frames (the server went away, the network is down, or the stream ended); opening it "
            "again every " +
-           std::to_string(reconnect_ms_) + " ms until it answers";
+           std::to_string(reconnect_ms_) + " ms until it answers");
 }
 
 bool Playback::reconnect(const WaitUntil& wait) {
@@ -126,14 +129,31 @@ bool Playback::reconnect(const WaitUntil& wait) {
   std::ostringstream text;
   text.precision(3);
   text << path_ << " is back after " << away_s << " s (" << attempts_ << " attempts)";
-  if (!news_.empty()) news_ += "; ";
-  news_ += text.str();
+  add_news(text.str());
   lost_since_ns_ = 0;
   ++reconnects_;
   return true;
 }
 
+void Playback::add_news(const std::string& text) {
+  if (!news_.empty()) news_ += "; ";
+  news_ += text;
+}
+
 std::string Playback::take_news() { return std::exchange(news_, std::string()); }
+
+std::uint64_t Playback::take_drops() {
+  const std::uint64_t passed_over = late_ + undecodable_;
+  return passed_over - std::exchange(drops_taken_, passed_over);
+}
+
+std::string Playback::status() const {
+  if (reconnecting()) return "lost, reconnecting";
+  if (undecodable_ > 0) return std::to_string(undecodable_) + " corrupt frames skipped";
+  if (reconnects_ > 0) return "reconnected";
+  if (passes_ > 0) return "started again " + std::to_string(passes_) + " times";
+  return {};
+}
 
 std::optional<Frame> Playback::paced_read(const WaitUntil& wait) {
   if (pace_start_ns_ == 0) pace_start_ns_ = realtime_now_ns();

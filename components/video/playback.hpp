@@ -56,8 +56,14 @@ class Playback {
   // attempt). Errors of the source (a truncated file, a camera unplugged) are thrown as
   // VideoSource throws them.
   std::optional<StampedFrame> next(const WaitUntil& wait);
-  // What happened to a stream since the last call, for logs (lost, back): empty when nothing.
+  // What happened to the source since the last call, for logs (a stream lost or back, corrupt
+  // frames skipped): empty when nothing.
   std::string take_news();
+  // Frames passed over (late, or undecodable) since the last call: a node's drops.
+  std::uint64_t take_drops();
+  // The source's state in a few words, for a status line: "lost, reconnecting", "N corrupt frames
+  // skipped", "reconnected", "started again P times", or empty while nothing of note happened.
+  std::string status() const;
 
   const VideoSource& source() const { return source_; }
   // For logs: "file PATH, WxH, F fps, N frames, offline", with a note when an option asked for
@@ -83,6 +89,7 @@ class Playback {
   void lose_stream();
   bool reconnect(const WaitUntil& wait);  // false while the stream is not back (or stopped)
   double frame_period_s() const;
+  void add_news(const std::string& text);
 
   std::string path_;
   SourceOptions source_options_;
@@ -96,6 +103,7 @@ class Playback {
   std::int64_t lost_since_ns_ = 0, next_attempt_ns_ = 0;  // while a stream is lost
   std::int64_t index_base_ = 0;  // frames of the connections before this one
   std::uint64_t reconnects_ = 0, losses_ = 0, attempts_ = 0;
+  std::uint64_t drops_taken_ = 0;  // late_ + undecodable_ as of the last take_drops()
   std::string news_;
 };
 

@@ -1,13 +1,10 @@
 // source.video: frames from a video file, a camera device (/dev/videoN), a network stream
-// (rtsp://, http://) or a folder of numbered images, read by video::Playback (components/video:
-// offline every frame stamped with its time in the source; live paced like a camera, late frames
-// passed over; loop). Put a `latest` edge after it in live graphs so a slow consumer takes the
-// newest frame. Late and damaged frames (FFmpeg could not decode them) are this node's drops.
-// A file, or a file served over HTTP/RTSP, that stops well before the frames its container
-// announces stops the graph with an error naming the input (the run ends incomplete, exit 1).
-// A live stream (a network camera) that stops is lost, not ended: logged naming the camera and
-// shown as the node's status, then opened again every reconnect_ms until it answers; the graph
-// keeps running (the other cameras of a rig go on).
+// (rtsp://, http://) or a folder of numbered images, read by video::Playback (offline every frame
+// stamped with its time in the source; live paced like a camera, late frames passed over; loop).
+// Put a `latest` edge after it in live graphs. A file (also served over HTTP/RTSP) that stops well
+// before the frames its container announces stops the graph with an error naming the input. A
+// live stream that stops is lost, not ended: logged, shown as the status, and opened again every
+// reconnect_ms while the graph (the rig's other cameras) goes on.
 
 #include <iostream>
 #include <optional>
@@ -79,11 +76,7 @@ class VideoSourceNode : public Node {
     auto frame = playback_->next([&ctx](std::int64_t due_ns) {
       return ctx.sleep_for(std::chrono::nanoseconds(due_ns - realtime_ns()));
     });
-    report_losses(ctx);
-    if (const std::string news = playback_->take_news(); !news.empty()) {
-      std::cerr << ctx.node_name() << " (camera " << camera_ << "): " << news << "\n";
-      ctx.report_status(playback_->reconnecting() ? "lost, reconnecting" : "reconnected");
-    }
+    report(ctx);
     if (!frame) {
       if (!playback_->stopped() && !playback_->reconnecting()) ctx.finish();
       return;
@@ -104,28 +97,19 @@ class VideoSourceNode : public Node {
 
  private:
   // Frames passed over (late, or damaged frames FFmpeg could not decode) are this node's drops;
-  // damaged ones are logged and shown in the status line, as are the passes of a loop.
-  void report_losses(Context& ctx) {
-    for (; late_ < playback_->late_frames_passed_over(); ++late_) ctx.count_drop();
-    const std::uint64_t undecodable = playback_->undecodable_frames();
-    if (undecodable > undecodable_) {
-      for (std::uint64_t i = undecodable_; i < undecodable; ++i) ctx.count_drop();
-      std::cerr << ctx.node_name() << ": " << undecodable - undecodable_
-                << " corrupt frames skipped in " << playback_->source().source() << " ("
-                << undecodable << " so far)\n";
-      undecodable_ = undecodable;
-      ctx.report_status(std::to_string(undecodable_) + " corrupt frames skipped");
-    } else if (playback_->passes_started_again() > passes_ && undecodable_ == 0) {
-      ctx.report_status("started again " + std::to_string(playback_->passes_started_again()) +
-                        " times");
-    }
-    passes_ = playback_->passes_started_again();
+  // what happened to the source (a stream lost or back, corrupt frames, a loop's passes) is logged
+  // naming the camera and shown as the node's status.
+  void report(Context& ctx) {
+    for (std::uint64_t n = playback_->take_drops(); n > 0; --n) ctx.count_drop();
+    if (const std::string news = playback_->take_news(); !news.empty())
+      std::cerr << ctx.node_name() << " (camera " << camera_ << "): " << news << "\n";
+    if (std::string status = playback_->status(); status != status_)
+      ctx.report_status(status_ = std::move(status));
   }
 
   std::optional<video::Playback> playback_;
-  std::uint64_t count_ = 0, sent_ = 0, late_ = 0, undecodable_ = 0, passes_ = 0;
-  std::string camera_;
-  std::string stream_;
+  std::uint64_t count_ = 0, sent_ = 0;
+  std::string camera_, stream_, status_;
 };
 
 MOCAP_REGISTER_NODE("source.video", VideoSourceNode)
