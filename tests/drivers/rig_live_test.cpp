@@ -23,6 +23,7 @@
 #include "private_loopback.hpp"
 #include "support/files.hpp"
 #include "support/mocap_process.hpp"
+#include "support/run_outputs.hpp"
 #include "support/shared_data.hpp"
 
 namespace mocap::test {
@@ -191,19 +192,10 @@ TEST_F(RigLiveSync, ReconstructTakesCamerasAsViewsUntilCtrlC) {
   ASSERT_TRUE(streaming) << err;
   EXPECT_EQ(code, 130) << err;  // interrupted, as the monocular command on a camera
   // Whole files: every line parses, the sets in order.
-  const auto lines = read_lines(poses);
+  const auto lines = test::expect_whole_poses_in_order(poses, err);
   ASSERT_GE(lines.size(), 3u);
-  std::int64_t last = -1;
-  for (const std::string& line : lines) {
-    ASSERT_TRUE(nlohmann::json::accept(line)) << "a cut line in poses.jsonl: " << line << "\n"
-                                              << err;
-    const std::int64_t frame = nlohmann::json::parse(line).at("frame").get<std::int64_t>();
-    EXPECT_GT(frame, last) << err;
-    last = frame;
-  }
-  const std::string summary_text = read_file(dir.file("out") + "/summary.json");
-  ASSERT_TRUE(nlohmann::json::accept(summary_text)) << summary_text << "\n" << err;
-  const nlohmann::json summary = nlohmann::json::parse(summary_text);
+  const nlohmann::json summary = test::read_summary(dir.file("out") + "/summary.json", err);
+  ASSERT_FALSE(summary.is_null());
   EXPECT_EQ(summary.at("completed"), false);
   EXPECT_EQ(summary.at("fit"), "live");  // auto: live for cameras
   ASSERT_EQ(summary.at("views").size(), kCameras);

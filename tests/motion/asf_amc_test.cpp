@@ -13,9 +13,12 @@
 #include "core/input_error.hpp"
 #include "motion/bvh.hpp"
 #include "motion/pose_sequence.hpp"
+#include "support/errors.hpp"
 
 namespace mocap::motion {
 namespace {
+
+using test::error_of;
 
 // ---- An independent evaluation of the ASF equations (plain 3x3 matrices, no glm) ----
 //
@@ -252,15 +255,6 @@ void expect_matches_asf_equations(const Clip& clip) {
 Clip test_clip() { return parse_amc(parse_asf(kAsf, "test.asf"), amc_text(), "test.amc"); }
 
 // The message of the InputError that `f` throws ("" when it throws none).
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
-}
-
 std::string replaced(std::string text, const std::string& from, const std::string& to) {
   const size_t at = text.find(from);
   EXPECT_NE(at, std::string::npos) << from;

@@ -18,10 +18,13 @@
 
 #include "core/input_error.hpp"
 #include "motion/bvh.hpp"
+#include "support/errors.hpp"
 #include "support/shared_data.hpp"
 
 namespace mocap::motion {
 namespace {
+
+using test::error_of;
 
 // A root with position channels, a chain of joints in two channel orders and an End Site:
 // `joints` joints, 3 + 3 * joints channels.
@@ -217,15 +220,6 @@ TEST(BvhStreamWriter, AKillWhileCreatingFilesLeavesNoTemporaryFile) {
       EXPECT_EQ(read_bvh(e.path().string()).frame_count, 0) << e.path();
     }
   }
-}
-
-std::string error_of(const std::function<void()>& action) {
-  try {
-    action();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "no error";
 }
 
 TEST(BvhStreamWriter, ErrorsNameTheFile) {

@@ -19,10 +19,12 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/input_error.hpp"
+#include "support/errors.hpp"
 #include "support/files.hpp"
 #include "support/mocap_process.hpp"
 #include "support/network.hpp"
 #include "support/rtsp_server.hpp"
+#include "support/run_outputs.hpp"
 #include "support/shared_data.hpp"
 #include "video/playback.hpp"
 #include "video/video_source.hpp"
@@ -85,15 +87,6 @@ std::pair<int, double> closest(const cv::Mat& frame, const std::vector<cv::Mat>&
     if (difference < best.second) best = {static_cast<int>(i), difference};
   }
   return best;
-}
-
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
 }
 
 #define MOCAP_REQUIRE_SERVER(server) \
@@ -288,18 +281,9 @@ TEST(RtspReconstruct, TwoStreamsAreViewsUntilCtrlCAndALostOneLeavesTheOtherGoing
   EXPECT_TRUE(went_on) << err;
   EXPECT_EQ(code, 130) << err;  // interrupted, as on any camera
   // Whole files: every line parses, the sets in order.
-  const auto lines = read_lines(poses);
-  std::int64_t last = -1;
-  for (const std::string& line : lines) {
-    ASSERT_TRUE(nlohmann::json::accept(line)) << "a cut line in poses.jsonl: " << line << "\n"
-                                              << err;
-    const std::int64_t frame = nlohmann::json::parse(line).at("frame").get<std::int64_t>();
-    EXPECT_GT(frame, last) << err;
-    last = frame;
-  }
-  const std::string summary_text = read_file(out + "/summary.json");
-  ASSERT_TRUE(nlohmann::json::accept(summary_text)) << summary_text << "\n" << err;
-  const nlohmann::json summary = nlohmann::json::parse(summary_text);
+  const auto lines = expect_whole_poses_in_order(poses, err);
+  const nlohmann::json summary = read_summary(out + "/summary.json", err);
+  ASSERT_FALSE(summary.is_null());
   EXPECT_EQ(summary.at("completed"), false);
   ASSERT_EQ(summary.at("views").size(), 2u);
   const nlohmann::json& a = summary.at("views")[0];

@@ -13,24 +13,18 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "core/input_error.hpp"
+#include "support/errors.hpp"
 #include "support/files.hpp"
 
 namespace mocap::video {
 namespace {
 
+using test::error_of;
+
 namespace fs = std::filesystem;
 
 const std::string kVtestPart = "../shared/data/eval/opencv_samples/vtest_part0.avi";
 const std::string kStreetVideo = "../shared/data/eval/openpose_examples_media/video.avi";
-
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
-}
 
 void expect_names(const std::string& error, const std::string& path, const std::string& what) {
   EXPECT_NE(error.find(path), std::string::npos) << error;
