@@ -234,9 +234,10 @@ std::vector<std::string> describe(const ViewCheck& check, std::span<const camera
     std::snprintf(factor, sizeof factor, "%.3f", s.factor);
     lines.push_back(labels[s.view] + " looks made at another image size: its keypoints times " +
                     factor + " fit the other cameras (error " + px(s.before_px) + " -> " +
-                    px(s.after_px) + " px), as from " + std::to_string(s.image_width) + "x" +
-                    std::to_string(s.image_height) + " images, but the camera is " +
-                    std::to_string(c.width) + "x" + std::to_string(c.height) +
+                    px(s.after_px) + " px), as from images of about " +
+                    std::to_string(s.image_width) + "x" + std::to_string(s.image_height) +
+                    " images, but the camera is " + std::to_string(c.width) + "x" +
+                    std::to_string(c.height) +
                     "; run the detector on the calibrated size (or calibrate at the size used)");
   }
   for (const std::size_t v : check.unexplained)
