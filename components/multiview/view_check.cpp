@@ -11,7 +11,9 @@
 namespace mocap::multiview {
 namespace {
 
-constexpr std::size_t kAllPairsUpTo = 8;
+// Up to this many cameras every view (and pair) is tried, not only the flagged ones: at most 15
+// pairs. With more, the others' consensus outvotes a wrong view, which is then flagged itself.
+constexpr std::size_t kEveryViewUpTo = 6;
 
 bool somebody(const std::vector<camera::BodyKeypoints>& people) { return !people.empty(); }
 
@@ -38,29 +40,41 @@ double median(std::vector<double> values) {
   return *middle;
 }
 
-// The level an explained camera must come down to: the median error of the cameras that were not
-// flagged, by the flag rule itself (flag_ratio times it, or under min_flag_px). NaN: no such
-// camera.
-double allowed_px(const ViewErrorReport& given, const ViewErrorOptions& options) {
-  std::vector<double> good;
-  for (const ViewError& e : given.views)
-    if (!e.flagged && e.points > 0) good.push_back(e.median_px);
-  const double level = median(good);
-  return std::isnan(level) ? level : std::max(options.min_flag_px, options.flag_ratio * level);
+// The mean of the cameras' median errors (those with points), and how many have points.
+struct RigLevel {
+  double mean_px = 0;
+  std::size_t cameras = 0;
+};
+
+RigLevel level(const ViewErrorReport& report) {
+  RigLevel out;
+  for (const ViewError& e : report.views) {
+    if (e.points == 0) continue;
+    out.mean_px += e.median_px;
+    ++out.cameras;
+  }
+  if (out.cameras) out.mean_px /= static_cast<double>(out.cameras);
+  return out;
 }
 
-// An explanation holds when the cameras it touches come down to the allowed level, unflagged,
-// and no camera that was not flagged before becomes flagged (other flagged cameras may stay so:
-// they may have an explanation of their own).
-bool accepted(const ViewErrorReport& before, const ViewErrorReport& after,
-              std::span<const std::size_t> touched, double allowed) {
-  if (std::isnan(allowed)) return false;
-  for (std::size_t v = 0; v < after.views.size(); ++v)
-    if (after.views[v].flagged && !before.views[v].flagged) return false;
-  return std::all_of(touched.begin(), touched.end(), [&](std::size_t v) {
-    return after.views[v].points > 0 && !after.views[v].flagged &&
-           after.views[v].median_px <= allowed;
-  });
+// An explanation holds when each camera it touches has its median error lowered by the flag
+// rule's own ratio (or had none to compare: the others could not triangulate its joints, which
+// the mistake itself may cause; at least one of them had one), and the whole rig's mean error
+// too, no camera losing its points. A camera may stay flagged (its calibration may be off as
+// well), but a partial explanation that leaves the rest as bad does not hold. On a right rig an
+// exchange or a scale makes the cameras it touches worse, never twice better.
+bool explains(const ViewErrorReport& before, const ViewErrorReport& after,
+              std::span<const std::size_t> touched, const ViewErrorOptions& options) {
+  bool compared = false;
+  for (const std::size_t v : touched) {
+    const ViewError &was = before.views[v], &is = after.views[v];
+    if (is.points == 0) return false;
+    if (was.points == 0) continue;
+    if (is.median_px * options.flag_ratio > was.median_px) return false;
+    compared = true;
+  }
+  const RigLevel was = level(before), is = level(after);
+  return compared && is.cameras >= was.cameras && is.mean_px * options.flag_ratio <= was.mean_px;
 }
 
 std::vector<std::size_t> flagged_views(const ViewErrorReport& report) {
@@ -74,47 +88,38 @@ bool same_size(const camera::Camera& a, const camera::Camera& b) {
   return a.width == b.width && a.height == b.height;
 }
 
-// The median of the cameras' medians: the rig's common level.
-double level_px(const ViewErrorReport& report) {
-  std::vector<double> medians;
-  for (const ViewError& e : report.views)
-    if (e.points > 0) medians.push_back(e.median_px);
-  return median(medians);
+// Whether views a and b are candidates: every view with few cameras (an exchange or a scale
+// there spoils every camera's check alike, since the others' triangulation holds the wrong view,
+// and may flag nobody), else the flagged ones.
+bool candidate(const ViewErrorReport& report, std::size_t v) {
+  return report.views.size() <= kEveryViewUpTo || report.views[v].flagged;
 }
 
-// The best exchange of two views of one image size that explains the errors; false if none.
-// With cameras flagged: pairs with a flagged camera, accepted as `accepted` says. With nobody
-// flagged (few cameras: an exchange spoils every camera's check, since the others' triangulation
-// holds both exchanged views, and all read alike): every pair, accepted when it flags nobody and
-// lowers the common level by the flag rule's own ratio.
-bool find_exchange(std::span<const camera::Camera> cameras,
-                   std::vector<camera::BodySequence>& views, const ViewErrorReport& given,
-                   double allowed, const ViewErrorOptions& options, ExchangedViews& found) {
-  const bool nobody_flagged = flagged_views(given).empty();
+// The exchange of two views of one image size that explains the errors best: the rig's mean
+// error after it (infinity: none explains them).
+double find_exchange(std::span<const camera::Camera> cameras,
+                     std::vector<camera::BodySequence>& views, const ViewErrorReport& given,
+                     const ViewErrorOptions& options, ExchangedViews& found) {
   double best = std::numeric_limits<double>::infinity();
   for (std::size_t a = 0; a < views.size(); ++a) {
     for (std::size_t b = a + 1; b < views.size(); ++b) {
-      if (!nobody_flagged && !(given.views[a].flagged || given.views[b].flagged)) continue;
+      if (!(candidate(given, a) || candidate(given, b))) continue;
       if (!same_size(cameras[a], cameras[b])) continue;
       std::swap(views[a], views[b]);
       const ViewErrorReport after = view_errors(cameras, views, options);
       std::swap(views[a], views[b]);
       const std::size_t touched[] = {a, b};
-      const bool explains = nobody_flagged
-                                ? flagged_views(after).empty() &&
-                                      level_px(after) * options.flag_ratio <= level_px(given)
-                                : accepted(given, after, touched, allowed);
-      if (!explains) continue;
-      const double worst = std::max(after.views[a].median_px, after.views[b].median_px);
-      if (worst >= best) continue;
-      best = worst;
+      if (!explains(given, after, touched, options)) continue;
+      const double mean = level(after).mean_px;
+      if (mean >= best) continue;
+      best = mean;
       found = {a,
                b,
                {given.views[a].median_px, given.views[b].median_px},
                {after.views[a].median_px, after.views[b].median_px}};
     }
   }
-  return std::isfinite(best);
+  return best;
 }
 
 // The factor s that takes the view's keypoints (about the image origin) closest to where the
@@ -160,6 +165,36 @@ camera::BodySequence scaled(camera::BodySequence view, double factor) {
   return view;
 }
 
+// The view whose keypoints scaled (by their fitted factor) explain the errors best: the rig's
+// mean error after it (infinity: none explains them). Factors within min_scale_change of 1 are no
+// explanation, nor beyond 1/5..5 (4K keypoints for a 720p camera is 3x): a fit gone wrong.
+double find_scale(std::span<const camera::Camera> cameras, std::vector<camera::BodySequence>& views,
+                  const ViewErrorReport& given, const ViewCheckOptions& options,
+                  ScaledView& found) {
+  const ViewResiduals residuals = view_residuals(cameras, views, options.errors);
+  double best = std::numeric_limits<double>::infinity();
+  for (std::size_t v = 0; v < views.size(); ++v) {
+    if (!candidate(given, v) || given.views[v].points == 0) continue;
+    const double factor = fit_scale(cameras[v], residuals.views[v]);
+    if (!(std::abs(factor - 1) > options.min_scale_change) || factor < 0.2 || factor > 5) continue;
+    camera::BodySequence original = std::exchange(views[v], scaled(views[v], factor));
+    const ViewErrorReport after = view_errors(cameras, views, options.errors);
+    views[v] = std::move(original);
+    const std::size_t touched[] = {v};
+    if (!explains(given, after, touched, options.errors)) continue;
+    const double mean = level(after).mean_px;
+    if (mean >= best) continue;
+    best = mean;
+    found = {v,
+             factor,
+             given.views[v].median_px,
+             after.views[v].median_px,
+             static_cast<int>(std::lround(cameras[v].width / factor)),
+             static_cast<int>(std::lround(cameras[v].height / factor))};
+  }
+  return best;
+}
+
 std::string px(double value) {
   char text[32];
   std::snprintf(text, sizeof text, value < 10 ? "%.1f" : "%.0f", value);
@@ -179,44 +214,27 @@ ViewCheck check_views(std::span<const camera::Camera> cameras,
     check.errors.frames = std::min_element(given.begin(), given.end(), [](auto& a, auto& b) {
                             return a.size() < b.size();
                           })->size();
-  std::vector<std::size_t> flagged = flagged_views(check.errors);
-  // Nobody flagged: an exchange among few cameras may still be behind errors all alike; tried on
-  // every pair only up to kAllPairsUpTo cameras (28 evaluations): with more, the others'
-  // consensus outvotes the exchanged pair, which is then flagged itself.
-  if (flagged.empty() && views.size() > kAllPairsUpTo) return check;
-  const double allowed = allowed_px(check.errors, options.errors);
-  // Exchanges first (each found one applied before looking for the next), then the remaining
-  // flagged views one by one as scaled.
+  // Round by round the explanation, exchange or scale, that leaves the lowest mean error is
+  // applied, until none explains what is left (a view scaled and another pair exchanged can
+  // mimic each other with three cameras: the better one wins).
   ViewErrorReport current = check.errors;
-  ExchangedViews exchange;
-  while (check.exchanged.size() < views.size() / 2 &&
-         find_exchange(cameras, views, current, allowed, options.errors, exchange)) {
-    std::swap(views[exchange.first], views[exchange.second]);
-    check.exchanged.push_back(exchange);
+  for (std::size_t round = 0; round < views.size(); ++round) {
+    ExchangedViews exchange;
+    ScaledView scale;
+    const double by_exchange = find_exchange(cameras, views, current, options.errors, exchange);
+    const double by_scale = find_scale(cameras, views, current, options, scale);
+    if (!std::isfinite(std::min(by_exchange, by_scale))) break;
+    if (by_exchange <= by_scale) {
+      std::swap(views[exchange.first], views[exchange.second]);
+      check.exchanged.push_back(exchange);
+    } else {
+      views[scale.view] = scaled(views[scale.view], scale.factor);
+      check.scaled.push_back(scale);
+    }
     current = view_errors(cameras, views, options.errors);
-    flagged = flagged_views(current);
-    if (flagged.empty()) break;
   }
-  for (const std::size_t v : flagged) {
-    const ViewResiduals residuals = view_residuals(cameras, views, options.errors);
-    const double factor = fit_scale(cameras[v], residuals.views[v]);
-    if (!(std::abs(factor - 1) > options.min_scale_change)) {
-      check.unexplained.push_back(v);
-      continue;
-    }
-    camera::BodySequence original = std::exchange(views[v], scaled(views[v], factor));
-    const ViewErrorReport after = view_errors(cameras, views, options.errors);
-    const std::size_t touched[] = {v};
-    if (!accepted(current, after, touched, allowed)) {
-      views[v] = std::move(original);
-      check.unexplained.push_back(v);
-      continue;
-    }
-    check.scaled.push_back({v, factor, current.views[v].median_px, after.views[v].median_px,
-                            static_cast<int>(std::lround(cameras[v].width / factor)),
-                            static_cast<int>(std::lround(cameras[v].height / factor))});
-    current = after;
-  }
+  check.explained_errors = current;
+  check.unexplained = flagged_views(current);
   return check;
 }
 
