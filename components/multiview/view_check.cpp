@@ -254,13 +254,14 @@ std::vector<std::string> describe(const ViewCheck& check, std::span<const camera
                     factor + " fit the other cameras (error " + px(s.before_px) + " -> " +
                     px(s.after_px) + " px), as from images of about " +
                     std::to_string(s.image_width) + "x" + std::to_string(s.image_height) +
-                    " images, but the camera is " + std::to_string(c.width) + "x" +
+                    ", but the camera is " + std::to_string(c.width) + "x" +
                     std::to_string(c.height) +
                     "; run the detector on the calibrated size (or calibrate at the size used)");
   }
   for (const std::size_t v : check.unexplained)
-    lines.push_back(labels[v] + ": error " + px(check.errors.views[v].median_px) +
-                    " px, far worse than the other cameras' " + px(others_median(check.errors, v)) +
+    lines.push_back(labels[v] + ": error " + px(check.explained_errors.views[v].median_px) +
+                    " px, far worse than the other cameras' " +
+                    px(others_median(check.explained_errors, v)) +
                     " px, not explained by an exchange of views or another image size: check its "
                     "calibration (pose, intrinsics) and its keypoints");
   return lines;

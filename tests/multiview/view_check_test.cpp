@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <string>
 #include <utility>
 #include <vector>
@@ -55,8 +56,11 @@ std::vector<std::string> labels() {
 
 std::string said(const ViewCheck& check, const Demo& d) {
   std::string text = "medians px:";
-  for (const ViewError& e : check.errors.views)
-    text += " " + std::to_string(e.median_px) + (e.flagged ? " (flagged)" : "");
+  for (const ViewError& e : check.errors.views) {
+    char value[48];
+    std::snprintf(value, sizeof value, " %.1f%s", e.median_px, e.flagged ? " (flagged)" : "");
+    text += value;
+  }
   text += "\n";
   for (const std::string& line : describe(check, d.cameras, labels())) text += line + "\n";
   return text;
