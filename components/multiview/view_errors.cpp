@@ -40,37 +40,39 @@ int tallest(const std::vector<camera::BodyKeypoints>& people, double min_confide
 
 }  // namespace
 
-ViewErrorReport view_errors(std::span<const camera::Camera> cameras,
-                            std::span<const camera::BodySequence> views,
-                            const ViewErrorOptions& options) {
+ViewResiduals view_residuals(std::span<const camera::Camera> cameras,
+                             std::span<const camera::BodySequence> views,
+                             const ViewErrorOptions& options) {
   if (cameras.size() != views.size())
     throw std::invalid_argument("view_errors: one view per camera expected");
-  ViewErrorReport report;
-  report.views.resize(views.size());
-  if (views.size() < 3) return report;  // a view's joint needs two others to triangulate from
+  ViewResiduals out;
+  out.views.resize(views.size());
+  if (views.empty()) return out;
+  out.frames = std::min_element(views.begin(), views.end(), [](const auto& a, const auto& b) {
+                 return a.size() < b.size();
+               })->size();
+  if (views.size() < 3) return out;  // a view's joint needs two others to triangulate from
   std::vector<ViewGeometry> geometry;
   for (const camera::Camera& c : cameras) geometry.push_back(from_camera(c));
-  report.frames = std::min_element(views.begin(), views.end(), [](const auto& a, const auto& b) {
-                    return a.size() < b.size();
-                  })->size();
-  std::vector<std::vector<double>> errors(views.size());
   std::vector<PointObservation> others;
   std::vector<int> person(views.size());
-  for (std::size_t f = 0; f < report.frames; ++f) {
+  for (std::size_t f = 0; f < out.frames; ++f) {
     for (std::size_t v = 0; v < views.size(); ++v)
       person[v] = tallest(views[v][f], options.min_confidence);
     if (std::find(person.begin(), person.end(), -1) != person.end()) continue;
-    ++report.frames_used;
+    ++out.frames_used;
     for (int j = 0; j < kBodyJoints; ++j) {
       // Every view's keypoint of this joint, undistorted; confidence 0 when not usable.
       std::vector<PointObservation> seen(views.size());
+      std::vector<glm::dvec2> read(views.size());
       for (std::size_t v = 0; v < views.size(); ++v) {
         const Keypoint2D& k =
             views[v][f][static_cast<std::size_t>(person[v])][static_cast<std::size_t>(j)];
         seen[v].view = static_cast<int>(v);
         if (!(k.confidence >= options.min_confidence) || !std::isfinite(k.x) || !std::isfinite(k.y))
           continue;
-        const glm::dvec2 u = cameras[v].undistort_pixel({k.x, k.y});
+        read[v] = {k.x, k.y};
+        const glm::dvec2 u = cameras[v].undistort_pixel(read[v]);
         seen[v] = {static_cast<int>(v), static_cast<float>(u.x), static_cast<float>(u.y),
                    k.confidence};
       }
@@ -87,30 +89,53 @@ ViewErrorReport view_errors(std::span<const camera::Camera> cameras,
         const glm::dvec3 world(point.position);
         if (geometry[v].depth(world) <= 0) continue;
         const glm::dvec2 p = geometry[v].project(world);
-        const double error = std::hypot(p.x - seen[v].x, p.y - seen[v].y);
-        if (std::isfinite(error)) errors[v].push_back(error);
+        if (!std::isfinite(p.x) || !std::isfinite(p.y)) continue;
+        out.views[v].push_back({read[v], glm::dvec2(seen[v].x, seen[v].y), p});
       }
     }
   }
-  std::vector<double> medians;
+  return out;
+}
+
+ViewErrorReport view_errors(std::span<const camera::Camera> cameras,
+                            std::span<const camera::BodySequence> views,
+                            const ViewErrorOptions& options) {
+  const ViewResiduals residuals = view_residuals(cameras, views, options);
+  ViewErrorReport report;
+  report.views.resize(views.size());
+  report.frames = residuals.frames;
+  report.frames_used = residuals.frames_used;
   for (std::size_t v = 0; v < views.size(); ++v) {
+    std::vector<double> errors;
+    for (const ViewResidual& r : residuals.views[v])
+      errors.push_back(
+          std::hypot(r.projected.x - r.undistorted.x, r.projected.y - r.undistorted.y));
     ViewError& out = report.views[v];
-    out.points = errors[v].size();
-    if (errors[v].empty()) continue;
-    out.mean_px = std::accumulate(errors[v].begin(), errors[v].end(), 0.0) /
-                  static_cast<double>(errors[v].size());
-    out.median_px = median(errors[v]);
+    out.points = errors.size();
+    if (errors.empty()) continue;
+    out.mean_px =
+        std::accumulate(errors.begin(), errors.end(), 0.0) / static_cast<double>(errors.size());
+    out.median_px = median(errors);
   }
-  for (std::size_t v = 0; v < views.size(); ++v) {
-    std::vector<double> rest;
-    for (std::size_t o = 0; o < views.size(); ++o)
-      if (o != v && report.views[o].points > 0) rest.push_back(report.views[o].median_px);
-    if (rest.empty() || report.views[v].points == 0) continue;
-    const double typical = median(rest);
+  flag_views(report, options);
+  return report;
+}
+
+void flag_views(ViewErrorReport& report, const ViewErrorOptions& options) {
+  for (std::size_t v = 0; v < report.views.size(); ++v) {
+    report.views[v].flagged = false;
+    const double typical = others_median(report, v);
+    if (std::isnan(typical) || report.views[v].points == 0) continue;
     report.views[v].flagged = report.views[v].median_px > options.min_flag_px &&
                               report.views[v].median_px > options.flag_ratio * typical;
   }
-  return report;
+}
+
+double others_median(const ViewErrorReport& report, std::size_t view) {
+  std::vector<double> rest;
+  for (std::size_t o = 0; o < report.views.size(); ++o)
+    if (o != view && report.views[o].points > 0) rest.push_back(report.views[o].median_px);
+  return rest.empty() ? std::numeric_limits<double>::quiet_NaN() : median(rest);
 }
 
 }  // namespace mocap::multiview

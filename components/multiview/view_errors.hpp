@@ -17,6 +17,8 @@
 #include "camera/camera.hpp"
 #include "camera/frame_offsets.hpp"
 
+#include <glm/vec2.hpp>
+
 namespace mocap::multiview {
 
 struct ViewErrorOptions {
@@ -39,9 +41,31 @@ struct ViewErrorReport {
   std::size_t frames = 0;        // frames in the shortest view
 };
 
+// One joint seen by a camera: its keypoint as read (distorted pixels) and where the joint
+// triangulated from the other cameras projects (undistorted pixels), with the keypoint undistorted.
+struct ViewResidual {
+  glm::dvec2 keypoint;     // as read
+  glm::dvec2 undistorted;  // the keypoint, undistorted
+  glm::dvec2 projected;    // the others' joint, undistorted
+};
+
+// Per camera its residuals (the data behind view_errors), and the frame counts.
+struct ViewResiduals {
+  std::vector<std::vector<ViewResidual>> views;
+  std::size_t frames_used = 0, frames = 0;
+};
+ViewResiduals view_residuals(std::span<const camera::Camera> cameras,
+                             std::span<const camera::BodySequence> views,
+                             const ViewErrorOptions& options = {});
+
 // `views[v]` are camera v's frames (body_sequence: 15 joints, distorted pixels as read).
 ViewErrorReport view_errors(std::span<const camera::Camera> cameras,
                             std::span<const camera::BodySequence> views,
                             const ViewErrorOptions& options = {});
+
+// The median of the other cameras' medians (those with points); NaN when there are none.
+double others_median(const ViewErrorReport& report, std::size_t view);
+// Sets each camera's `flagged` by the rule of ViewErrorOptions.
+void flag_views(ViewErrorReport& report, const ViewErrorOptions& options);
 
 }  // namespace mocap::multiview

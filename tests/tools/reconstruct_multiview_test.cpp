@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <map>
+#include <regex>
 #include <string>
 #include <vector>
 
@@ -71,6 +72,24 @@ class ReconstructMultiView : public ::testing::Test {
       fs::copy_file(files[static_cast<std::size_t>(i)],
                     to / files[static_cast<std::size_t>(i)].filename());
     return to.string();
+  }
+
+  // Camera `c`'s first kFrames JSON files with every keypoint's x and y times `factor` (as if
+  // OpenPose had been run on the video resized by it), in a folder of their own.
+  std::string scaled_copy(int c, double factor, const std::string& name) {
+    const std::string folder = copy_view(c, kFrames, name);
+    for (const auto& e : fs::directory_iterator(folder)) {
+      json frame = json::parse(read_file(e.path().string()));
+      for (json& person : frame["people"]) {
+        json& k = person["pose_keypoints_2d"];
+        for (std::size_t i = 0; i + 2 < k.size(); i += 3) {
+          k[i] = k[i].get<double>() * factor;
+          k[i + 1] = k[i + 1].get<double>() * factor;
+        }
+      }
+      write_file(e.path().string(), frame.dump());
+    }
+    return folder;
   }
 
   // `fit` off unless the test is about the fit: the full fit is most of a run's time under
@@ -251,6 +270,40 @@ TEST_F(ReconstructMultiView, ARigThatDisagreesWithTheViewsIsRefusedNamingTheCame
   write_file(garbage, "[cam_01]\nname = \x01\x02 [[[");
   EXPECT_NE(run("garbage", args("garbage", views_, garbage), err), 0);
   EXPECT_NE(err.find(garbage), std::string::npos) << err;
+}
+
+// Two views given in each other's place (cameras of one size: the image-size check lets them
+// through) and a view whose keypoints were made at half its camera's size are refused before
+// anything is written, naming the views and the errors; --ignore-view-check goes on with the
+// finding as a warning.
+TEST_F(ReconstructMultiView, ExchangedViewsAndKeypointsOfAnotherSizeAreRefusedNamingThem) {
+  std::string err;
+  const std::vector<std::string> exchanged = {views_[0], views_[2], views_[1], views_[3]};
+  EXPECT_EQ(run("exchanged", args("exchanged", exchanged), err), 1) << err;
+  EXPECT_NE(err.find("view 2 (cam_02, " + views_[2] + ") and view 3 (cam_03, " + views_[1] +
+                     ") look exchanged"),
+            std::string::npos)
+      << err;
+  EXPECT_NE(err.find("give the views in the rig's camera order"), std::string::npos) << err;
+  EXPECT_FALSE(fs::exists(dir_.file("exchanged"))) << "refused before the output is made";
+
+  std::vector<std::string> resized = views_;
+  resized[3] = scaled_copy(4, 0.5, "cam4_half");
+  EXPECT_EQ(run("resized", args("resized", resized), err), 1) << err;
+  EXPECT_NE(err.find("view 4 (cam_04, " + resized[3] + ") looks made at another image size"),
+            std::string::npos)
+      << err;
+  std::smatch size;  // the fitted factor's size, within 1 % of the half size 544x960
+  ASSERT_TRUE(std::regex_search(err, size, std::regex("images of about ([0-9]+)x([0-9]+)"))) << err;
+  EXPECT_NEAR(std::stoi(size[1]), 544, 6) << err;
+  EXPECT_NEAR(std::stoi(size[2]), 960, 10) << err;
+  EXPECT_FALSE(fs::exists(dir_.file("resized")));
+
+  std::vector<std::string> a = args("anyway", exchanged);
+  a.push_back("--ignore-view-check");
+  ASSERT_EQ(run("anyway", a, err), 0) << err;
+  EXPECT_NE(err.find("warning: view 2 (cam_02"), std::string::npos) << err;
+  EXPECT_EQ(lines("anyway").size(), static_cast<std::size_t>(kFrames));
 }
 
 TEST_F(ReconstructMultiView, BadFramesAndAShorterViewLeaveTheOthersGoingOn) {

@@ -51,6 +51,17 @@ TEST_F(RigInfoViews, GivesEachCameraItsErrorAgainstTheOthers) {
     EXPECT_GT(median_of(out, camera), 0) << camera << "\n" << out;
   // cam_03's calibration is off (docs/cameras.md, frame offsets): worse than cam_02 by far.
   EXPECT_GT(cam03, 2 * cam02) << out;
+  EXPECT_EQ(out.find("exchanged"), std::string::npos) << out;
+  EXPECT_EQ(out.find("another image size"), std::string::npos) << out;
+}
+
+TEST_F(RigInfoViews, SaysWhichViewsLookExchanged) {
+  std::vector<std::string> a = {"rig", "info", rig_, views_[0], views_[2], views_[1], views_[3]};
+  Mocap info(dir_, "exchanged", a);
+  ASSERT_EQ(info.wait(std::chrono::seconds(60)), 0) << info.err();
+  EXPECT_NE(info.out().find("view 2 (cam_02) and view 3 (cam_03) look exchanged"),
+            std::string::npos)
+      << info.out();
 }
 
 TEST_F(RigInfoViews, GarbageViewsAreNamedAndSkipped) {

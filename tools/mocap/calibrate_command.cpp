@@ -628,6 +628,8 @@ int rig_people_command(int argc, char** argv) {
     for (const io::FrameProblem& p : json.problems)
       std::cerr << "mocap calibrate rig: " << v.json.string() << ": " << p.message << "\n";
     check_keypoints_fit(v, json, cameras[i]);
+    if (const std::string note = small_keypoints_note(v, json, cameras[i]); !note.empty())
+      std::cerr << "mocap calibrate rig: note: " << note << "\n";
     sequences.push_back(camera::body_sequence(json.frames));
     if (view_options.max_frames && sequences.back().size() > std::size_t(*view_options.max_frames))
       sequences.back().resize(static_cast<std::size_t>(*view_options.max_frames));

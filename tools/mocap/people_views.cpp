@@ -160,6 +160,29 @@ void check_people_views(const std::vector<PeopleView>& views,
   }
 }
 
+std::string small_keypoints_note(const PeopleView& view, const io::OpenPoseSequence& json,
+                                 const camera::Camera& camera) {
+  if (view.kind != InputKind::openpose_json) return "";
+  double max_x = 0, max_y = 0;
+  long total = 0;
+  for (const People2D& frame : json.frames)
+    for (const Person2D& person : frame.people)
+      for (const Keypoint2D& k : person.joints) {
+        if (!(k.confidence > 0) || !std::isfinite(k.x) || !std::isfinite(k.y)) continue;
+        max_x = std::max<double>(max_x, k.x);
+        max_y = std::max<double>(max_y, k.y);
+        ++total;
+      }
+  if (total == 0 || max_x >= camera.width / 2.0 || max_y >= camera.height / 2.0) return "";
+  std::ostringstream note;
+  note.precision(0);
+  note << std::fixed << "the keypoints of " << view.path << " (camera '" << camera.name << "', "
+       << size_text(camera.width, camera.height) << ") never pass x " << max_x << ", y " << max_y
+       << ": all in the top-left quarter of the image, as keypoints made at half the size or "
+          "smaller would be; if so, the camera comes out too far away (its error does not tell)";
+  return note.str();
+}
+
 void check_keypoints_fit(const PeopleView& view, const io::OpenPoseSequence& json,
                          const camera::Camera& camera) {
   if (view.kind != InputKind::openpose_json) return;

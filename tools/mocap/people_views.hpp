@@ -47,6 +47,15 @@ std::vector<PeopleView> open_people_views(const std::vector<std::string>& paths,
 void check_people_views(const std::vector<PeopleView>& views,
                         const std::vector<camera::Camera>& cameras);
 
+// OpenPose JSON whose keypoints all lie in the top-left quarter of the camera's image (x below
+// half its width and y below half its height, every frame): a note naming the view and the
+// extent, since keypoints made at half the size or smaller look like that, and the solve cannot
+// tell (it moves the camera away instead: docs/cameras.md); empty otherwise. Half size (1920 ->
+// 960) is where the extent tells: keypoints resized by 2/3 or 3/4 still reach where a person
+// off-centre would put them.
+std::string small_keypoints_note(const PeopleView& view, const io::OpenPoseSequence& json,
+                                 const camera::Camera& camera);
+
 // Refused (InputError naming the camera and the file of the farthest keypoint): an OpenPose JSON
 // view whose keypoints do not fit inside its camera's image. OpenPose JSON carries no image size,
 // so the keypoints' extent is the check: more than 1 % of the view's keypoints (and at least 3)

@@ -35,6 +35,7 @@
 #include "input_kind.hpp"
 #include "io/openpose_json.hpp"
 #include "multiview/rig_reconstruction.hpp"
+#include "multiview/view_check.hpp"
 #include "output_files.hpp"
 #include "progress_bar.hpp"
 #include "reconstruct_report.hpp"
@@ -63,6 +64,7 @@ struct View {
   double fps = 0.0;                             // videos: their own rate
   std::int64_t frame_offset = 0;                // added to the view's frame numbers (--offsets)
   std::optional<camera::ViewOffset> estimated;  // --offsets auto
+  camera::BodySequence keypoints;               // JSON views: the body joints of every frame
 };
 
 std::string size_text(int width, int height) {
@@ -73,8 +75,11 @@ std::string size_text(int width, int height) {
 // is another camera's (the order of the views) or of other images. Unreadable frames are left to
 // the source, which names them and goes on.
 void check_json_view(View& view, const std::string& rig_file) {
-  const io::OpenPoseSequence sequence = io::read_openpose_folder(view.path);
+  io::OpenPoseOptions layout;  // as source.openpose_json reads them (layout auto)
+  layout.body25 = io::Body25Choice::detect;
+  const io::OpenPoseSequence sequence = io::read_openpose_folder(view.path, layout);
   view.frames = static_cast<std::int64_t>(sequence.frames.size());
+  view.keypoints = camera::body_sequence(sequence.frames);
   float max_x = 0.0f, max_y = 0.0f;
   for (const People2D& frame : sequence.frames) {
     for (const Person2D& p : frame.people) {
@@ -159,6 +164,44 @@ void check_camera_view(View& view, const std::string& rig_file, const Args& args
                                            "give the views in the rig's camera order, each a "
                                            "camera that delivers its calibrated size"));
   view.fps = source.fps();
+}
+
+// The frames the views are checked against each other on (multiview/view_check.hpp): the first
+// of them in which every view shows somebody, at most ViewCheckOptions::max_frames, a bounded time.
+constexpr std::int64_t kCheckedFrames = 300;
+
+// JSON views checked against each other before anything is written: two views exchanged or a
+// view's keypoints made at another image size are refused, naming them and the errors (unless
+// --ignore-view-check: then printed as a warning); a camera far worse than the rest that neither
+// explains is a warning only (the rig may be off, which the run cannot mend but may live with).
+// The views are taken as the graph joins them: view i's frame t - offset at frame t.
+void check_views_agree(const std::vector<View>& views, bool ignore) {
+  std::vector<camera::Camera> cameras;
+  std::vector<camera::BodySequence> aligned(views.size());
+  std::vector<std::string> labels;
+  for (std::size_t i = 0; i < views.size(); ++i) {
+    const View& v = views[i];
+    if (v.kind != ViewKind::openpose_json) return;  // videos: the keypoints come later
+    cameras.push_back(*v.camera);
+    labels.push_back("view " + std::to_string(i + 1) + " (" + v.camera->name + ", " + v.path + ")");
+    for (std::int64_t t = 0; t < kCheckedFrames; ++t) {
+      const std::int64_t f = t - v.frame_offset;
+      const bool inside = f >= 0 && f < static_cast<std::int64_t>(v.keypoints.size());
+      aligned[i].push_back(inside ? v.keypoints[static_cast<std::size_t>(f)]
+                                  : std::vector<camera::BodyKeypoints>{});
+    }
+  }
+  const multiview::ViewCheck check = multiview::check_views(cameras, aligned);
+  const std::vector<std::string> findings = multiview::describe(check, cameras, labels);
+  if (findings.empty()) return;
+  std::string text;
+  for (const std::string& line : findings) text += (text.empty() ? "" : "; ") + line;
+  if (!check.explained() || ignore) {
+    std::cerr << "mocap reconstruct: warning: " << text << "\n";
+    return;
+  }
+  throw InputError("the views", text + " (checked on " + std::to_string(check.errors.frames_used) +
+                                    " frames; --ignore-view-check goes on anyway)");
 }
 
 // Files are joined by frame number, cameras by capture time: one run takes one or the other.
@@ -477,6 +520,10 @@ int reconstruct_multiview_command(int argc, char** argv) {
       .option("set", "NODE.PARAM=VALUE",
               "override a node parameter of the graph (e.g. solve.volume=x0,y0,z0,x1,y1,z1)",
               std::nullopt, true)
+      .flag("ignore-view-check",
+            "go on when OpenPose JSON views look exchanged or made at another image size than "
+            "their camera's (checked on their first frames with everybody in view; "
+            "docs/multiview.md), with a warning instead of refusing")
       .flag("quiet", "do not print statistics");
   int code = 0;
   if (!args.parse(argc, argv, code)) return code;
@@ -526,6 +573,7 @@ int reconstruct_multiview_command(int argc, char** argv) {
   check_frame_rates(views);
   if (fps <= 0.0) fps = 30.0;
   if (args.has("offsets")) apply_offsets(views, rig, args);
+  check_views_agree(views, args.has("ignore-view-check"));
   std::string floor_how;
   const GroundPlane floor = multiview::rig_floor(rig, &floor_how);
   // TRC files are Y-up (OpenSim): a world whose floor is level in x-y (Pose2Sim's, a board's) is

@@ -13,7 +13,7 @@
 #include "commands.hpp"
 #include "core/input_error.hpp"
 #include "io/openpose_json.hpp"
-#include "multiview/view_errors.hpp"
+#include "multiview/view_check.hpp"
 #include "view_offsets.hpp"
 
 namespace mocap::cli {
@@ -28,6 +28,10 @@ io::OpenPoseOptions json_options(const std::string& layout) {
                                           : io::Body25Choice::body25;
   return options;
 }
+
+// The frames `rig info` checks the views on (those with a person in every view): a bounded time,
+// and enough for a median over thousands of joints per camera.
+constexpr std::size_t kCheckedFrames = 300;
 
 // Per camera, how far its keypoints lie from the joints triangulated from the other cameras. A
 // view that cannot be read is named and left out (its camera then has no error).
@@ -57,13 +61,17 @@ void print_view_errors(const camera::Rig& rig, const std::string& file,
                 << rig.cameras[v].name << ") skipped\n";
     }
   }
-  const multiview::ViewErrorReport report = multiview::view_errors(cameras, views);
+  multiview::ViewCheckOptions check_options;
+  check_options.max_frames = kCheckedFrames;
+  const multiview::ViewCheck check = multiview::check_views(cameras, views, check_options);
+  const multiview::ViewErrorReport& report = check.errors;
   std::cout << "\nreprojection error per camera: its keypoints against the joints triangulated "
                "from the other\ncameras, over "
             << report.frames_used << " of " << report.frames
-            << " frames (those with a person in every view; per view its tallest)\n\n"
+            << " frames (those with a person in every view, at most " << kCheckedFrames
+            << "; per view its tallest)\n\n"
             << "| camera | points | median px | mean px | |\n|---|---|---|---|---|\n";
-  std::vector<std::string> flagged;
+  std::vector<std::string> labels;
   for (std::size_t v = 0; v < rig.cameras.size(); ++v) {
     const auto it = std::find(index.begin(), index.end(), v);
     char row[256];
@@ -75,16 +83,14 @@ void print_view_errors(const camera::Rig& rig, const std::string& file,
       std::snprintf(row, sizeof row, "| %s | %zu | %.1f | %.1f | %s |\n",
                     rig.cameras[v].name.c_str(), e.points, e.median_px, e.mean_px,
                     e.flagged ? "far worse than the rest" : "");
-      if (e.flagged) flagged.push_back(rig.cameras[v].name);
+      labels.push_back("view " + std::to_string(v + 1) + " (" + rig.cameras[v].name + ")");
     }
     std::cout << row;
   }
   if (views.size() < 3)
     std::cout << "fewer than 3 views read: a camera's keypoints need two others to check them\n";
-  for (const std::string& name : flagged)
-    std::cout << name
-              << ": its median error is more than twice the others': check its calibration "
-                 "(pose, intrinsics, image size) and that its view is in the rig's order\n";
+  for (const std::string& line : multiview::describe(check, cameras, labels))
+    std::cout << line << "\n";
 }
 
 int info(int argc, char** argv) {
@@ -97,7 +103,9 @@ int info(int argc, char** argv) {
             "intrinsics`. Given keypoints (VIEW: an OpenPose JSON folder per camera, in\nthe "
             "rig's order; at least 3), also the reprojection error per camera: its keypoints "
             "against\nthe joints triangulated from the other cameras (median, mean, points), a "
-            "camera far worse\nthan the rest flagged (docs/cameras.md).");
+            "camera far worse\nthan the rest flagged, and what explains it when something "
+            "does: two views exchanged, or\na view's keypoints made at another image size "
+            "(the factor and the size) (docs/cameras.md).");
   args.positional("RIG", "the rig file")
       .positional("VIEW", "OpenPose JSON folders, one per camera of the rig, in its order", true,
                   false)

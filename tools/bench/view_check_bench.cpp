@@ -1,0 +1,233 @@
+// mocap-bench-view-check [SHARED_DATA]: what multiview::check_views (multiview/view_check.hpp)
+// says of views as given, of two views exchanged and of one view's keypoints scaled (as if made
+// at another image size), on
+//  * Pose2Sim's demo (4 portrait cameras 1088x1920, balancing and static trials, its OpenPose
+//    BODY_25B JSON): every pair exchanged, every camera scaled by 1/2, 2/3 and 3/4;
+//  * HumanEva-I's Train chunks of 60 frames or more (3 cameras 640x480, ground-truth 2D through
+//    the folder's fitted pinhole cameras), as given and with 3 px of Gaussian noise: false alarms
+//    counted, and every pair exchanged and every camera scaled by 1/2.
+// Markdown tables: per case the medians as given, what was said, the time. Only evaluated here:
+// no threshold of check_views was chosen on these data (ViewCheckOptions, set beforehand).
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <random>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "camera/rig_file.hpp"
+#include "io/humaneva.hpp"
+#include "io/openpose_json.hpp"
+#include "multiview/view_check.hpp"
+
+namespace fs = std::filesystem;
+using namespace mocap;
+
+namespace {
+
+struct Views {
+  std::vector<camera::Camera> cameras;
+  std::vector<camera::BodySequence> views;
+};
+
+camera::BodySequence scaled(camera::BodySequence view, float factor) {
+  for (auto& people : view)
+    for (auto& person : people)
+      for (Keypoint2D& k : person) {
+        k.x *= factor;
+        k.y *= factor;
+      }
+  return view;
+}
+
+// What check_views said, in a few words: "exchanged 2-3", "scaled 4 x2.00 (544x960)", "flagged 1
+// unexplained", "-".
+std::string verdict(const multiview::ViewCheck& check) {
+  std::string text;
+  const auto add = [&](const std::string& part) { text += (text.empty() ? "" : "; ") + part; };
+  for (const auto& e : check.exchanged)
+    add("exchanged " + std::to_string(e.first + 1) + "-" + std::to_string(e.second + 1));
+  for (const auto& s : check.scaled) {
+    char line[96];
+    std::snprintf(line, sizeof line, "scaled %zu x%.3f (%dx%d)", s.view + 1, s.factor,
+                  s.image_width, s.image_height);
+    add(line);
+  }
+  for (const std::size_t v : check.unexplained)
+    add("flagged " + std::to_string(v + 1) + " unexplained");
+  return text.empty() ? "-" : text;
+}
+
+std::string medians(const multiview::ViewCheck& check) {
+  std::string text;
+  for (const auto& e : check.errors.views) {
+    char value[32];
+    std::snprintf(value, sizeof value, "%s%.1f%s", text.empty() ? "" : " ", e.median_px,
+                  e.flagged ? "*" : "");
+    text += value;
+  }
+  return text;
+}
+
+struct Outcome {
+  multiview::ViewCheck check;
+  double ms = 0;
+};
+
+Outcome run(const Views& v) {
+  const auto start = std::chrono::steady_clock::now();
+  Outcome out{multiview::check_views(v.cameras, v.views), 0};
+  out.ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return out;
+}
+
+// What a case expects: nothing explained, an exchange of views a and b, or view a scaled by
+// `factor` (within 5 %).
+struct Expected {
+  enum { nothing, exchange, scale } kind = nothing;
+  std::size_t a = 0, b = 0;
+  double factor = 1;
+
+  bool met(const multiview::ViewCheck& c) const {
+    switch (kind) {
+      case nothing:
+        return !c.explained();
+      case exchange:
+        return c.scaled.empty() && c.exchanged.size() == 1 && c.exchanged[0].first == a &&
+               c.exchanged[0].second == b;
+      case scale:
+        return c.exchanged.empty() && c.scaled.size() == 1 && c.scaled[0].view == a &&
+               std::abs(c.scaled[0].factor / factor - 1) < 0.05;
+    }
+    return false;
+  }
+};
+
+struct Tally {
+  int cases = 0, right = 0;
+};
+
+void row(const std::string& data, const std::string& alteration, const Expected& expected,
+         const Outcome& o, Tally& tally) {
+  const bool right = expected.met(o.check);
+  ++tally.cases;
+  tally.right += right;
+  std::printf("| %s | %s | %s | %s | %s | %.0f |\n", data.c_str(), alteration.c_str(),
+              medians(o.check).c_str(), verdict(o.check).c_str(), right ? "yes" : "**no**", o.ms);
+}
+
+// Every alteration of `given`: as given, each pair exchanged, each camera scaled by `factors`.
+void alterations(const std::string& data, const Views& given, const std::vector<float>& factors,
+                 Tally& tally) {
+  row(data, "as given", {}, run(given), tally);
+  for (std::size_t a = 0; a < given.views.size(); ++a)
+    for (std::size_t b = a + 1; b < given.views.size(); ++b) {
+      Views v = given;
+      std::swap(v.views[a], v.views[b]);
+      const std::string pair = std::to_string(a + 1) + "-" + std::to_string(b + 1);
+      row(data, "exchanged " + pair, {Expected::exchange, a, b, 1}, run(v), tally);
+    }
+  for (std::size_t c = 0; c < given.views.size(); ++c)
+    for (const float f : factors) {
+      Views v = given;
+      v.views[c] = scaled(v.views[c], f);
+      char alteration[64];
+      std::snprintf(alteration, sizeof alteration, "%zu made at x%.3f", c + 1, f);
+      row(data, alteration, {Expected::scale, c, 0, 1 / f}, run(v), tally);
+    }
+}
+
+Views pose2sim(const fs::path& shared, const std::string& trial) {
+  const fs::path demo = shared / "eval/pose2sim_demo";
+  Views v;
+  v.cameras = camera::read_rig(demo / "calibration/Calib_qualisys.toml").cameras;
+  io::OpenPoseOptions options;
+  options.body25 = io::Body25Choice::detect;
+  for (int c = 1; c <= 4; ++c)
+    v.views.push_back(camera::body_sequence(
+        io::read_openpose_folder(demo / trial / "pose" / ("cam0" + std::to_string(c) + "_json"),
+                                 options)
+            .frames));
+  return v;
+}
+
+// A HumanEva chunk's ground-truth 2D as body joints (HumanEva-15 -> Body15 is a choice of one
+// joint per Body15 joint, so to_body15 maps the pixels given as (x, y, 0)), with `noise_px` of
+// Gaussian noise.
+Views humaneva(const io::humaneva::Chunk& chunk, const camera::Rig& rig, double noise_px,
+               std::mt19937& random) {
+  std::normal_distribution<float> noise(0.0f, static_cast<float>(noise_px));
+  Views v;
+  v.cameras = rig.cameras;
+  for (int c = 0; c < io::humaneva::kCameras; ++c) {
+    camera::BodySequence view;
+    for (const io::humaneva::Pose2& pose : chunk.positions_2d[static_cast<std::size_t>(c)]) {
+      io::humaneva::Pose3 flat;
+      for (int j = 0; j < io::humaneva::kJoints; ++j)
+        flat[static_cast<std::size_t>(j)] = {pose[static_cast<std::size_t>(j)], 0.0f};
+      const auto body = io::humaneva::to_body15(flat);
+      camera::BodyKeypoints person;
+      for (int j = 0; j < kBodyJoints; ++j) {
+        const glm::vec3& p = body[static_cast<std::size_t>(j)];
+        person[static_cast<std::size_t>(j)] = {p.x + (noise_px > 0 ? noise(random) : 0.0f),
+                                               p.y + (noise_px > 0 ? noise(random) : 0.0f), 1.0f};
+      }
+      view.push_back({person});
+    }
+    v.views.push_back(std::move(view));
+  }
+  return v;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const fs::path shared = argc > 1 ? fs::path(argv[1]) : fs::path("../shared/data");
+  std::printf(
+      "| data | alteration | medians px as given (* flagged) | said | right | ms "
+      "|\n|---|---|---|---|---|---:|\n");
+  Tally pose2sim_tally, humaneva_tally;
+  for (const char* trial : {"S00_P00_T01_BalancingTrial", "S00_P00_T00_StaticTrial"})
+    if (fs::exists(shared / "eval/pose2sim_demo" / trial))
+      alterations(
+          std::string("pose2sim ") +
+              (std::string(trial).find("T01") != std::string::npos ? "balancing" : "static"),
+          pose2sim(shared, trial), {0.5f, 2.0f / 3.0f, 0.75f}, pose2sim_tally);
+  std::printf("\nPose2Sim's demo: %d of %d cases right\n\n", pose2sim_tally.right,
+              pose2sim_tally.cases);
+
+  const fs::path he = shared / "eval/humaneva_i_videopose3d";
+  if (!fs::exists(he / io::humaneva::kCamerasFile)) return 0;
+  const io::humaneva::Dataset dataset = io::humaneva::load_dataset(he);
+  const auto rigs = io::humaneva::load_cameras(he / io::humaneva::kCamerasFile);
+  std::mt19937 random(11);
+  int chunks = 0, false_alarms = 0, flagged = 0;
+  for (const io::humaneva::Chunk* chunk : dataset.select(io::humaneva::Split::train)) {
+    if (chunk->frames() < 60) continue;
+    for (const double noise : {0.0, 3.0}) {
+      const Views v = humaneva(*chunk, rigs.at(chunk->subject), noise, random);
+      const std::string data =
+          "HumanEva Train/" + chunk->subject + " " + chunk->key + (noise > 0 ? " +3 px" : "");
+      const Outcome given = run(v);
+      ++chunks;
+      false_alarms += given.check.explained();
+      flagged += !given.check.unexplained.empty();
+      // As given: shown when something is said; every chunk 0 with noise: all its alterations.
+      if (chunk->key.ends_with("chunk0") && noise > 0)
+        alterations(data, v, {0.5f}, humaneva_tally);
+      else if (given.check.explained() || !given.check.unexplained.empty())
+        row(data, "as given", {}, given, humaneva_tally);
+    }
+  }
+  std::printf("\nHumanEva rows above: %d of %d right\n", humaneva_tally.right,
+              humaneva_tally.cases);
+  std::printf(
+      "HumanEva Train, chunks of 60 frames or more, as given (0 and 3 px noise): %d "
+      "checks, %d explained (false alarms), %d with a flagged camera left unexplained\n",
+      chunks, false_alarms, flagged);
+  return 0;
+}
