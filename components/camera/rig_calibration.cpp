@@ -4,6 +4,7 @@
 #include <cctype>
 #include <cmath>
 #include <filesystem>
+#include <iomanip>
 #include <limits>
 #include <numeric>
 #include <sstream>
@@ -326,14 +327,47 @@ Graph spanning_tree(const std::vector<std::vector<int>>& shared, const std::vect
 
 // ---------------------------------------------------------------- the world from the floor board
 
-// World <- board of the floor frame: x along the board's x, y against its y, z up (the board's z
-// points into the floor for a board lying face up).
-Rigid world_from_floor_board() { return {cv::Matx33d(1, 0, 0, 0, -1, 0, 0, 0, -1), {}}; }
-
 glm::dmat3 to_glm(const cv::Matx33d& m) {
   glm::dmat3 out;
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 3; ++c) out[c][r] = m(r, c);
+  return out;
+}
+
+// The frames whose board lies on the floor, checked: options.floor_frames, or floor_frame alone
+// (-1: the first frame with the board).
+std::vector<std::size_t> floor_frames_of(const RigBoardOptions& options,
+                                         const std::vector<std::optional<std::size_t>>& board_index,
+                                         const std::vector<std::size_t>& frame_of_board) {
+  std::vector<int> wanted = options.floor_frames;
+  if (wanted.empty())
+    wanted.push_back(options.floor_frame >= 0 ? options.floor_frame
+                                              : static_cast<int>(frame_of_board.front()));
+  std::vector<std::size_t> out;
+  for (int frame : wanted) {
+    const std::string where = "floor frame " + std::to_string(frame);
+    if (frame < 0 || static_cast<std::size_t>(frame) >= board_index.size())
+      throw InputError(where, "the views have " + std::to_string(board_index.size()) + " frames");
+    const auto f = static_cast<std::size_t>(frame);
+    if (!board_index[f])
+      throw InputError(
+          where, "no camera of the rig saw the board in this frame (try every frame: step 1)");
+    if (std::find(out.begin(), out.end(), f) != out.end())
+      throw InputError(where, "is listed twice");
+    out.push_back(f);
+  }
+  return out;
+}
+
+// The board points seen in one board pose of the bundle, each once (several cameras see the same
+// corner).
+std::vector<std::array<double, 3>> distinct_corners(const BundleProblem& problem,
+                                                    std::size_t board) {
+  std::vector<std::array<double, 3>> out;
+  for (const CornerObservation& o : problem.corners)
+    if (o.frame == board) out.push_back(o.object_m);
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
   return out;
 }
 
@@ -350,6 +384,63 @@ void check(const RigBoardOptions& o) {
 }
 
 }  // namespace
+
+namespace rig_calibration_detail {
+
+namespace {
+cv::Vec3d column(const cv::Matx33d& m, int c) { return {m(0, c), m(1, c), m(2, c)}; }
+}  // namespace
+
+FloorFit fit_floor(const std::vector<Pose>& boards,
+                   const std::vector<std::vector<std::array<double, 3>>>& corners) {
+  if (boards.empty() || boards.size() != corners.size())
+    throw std::invalid_argument("fit_floor: one set of corners per board, at least one board");
+  std::vector<Rigid> poses;
+  std::vector<std::vector<cv::Vec3d>> points(boards.size());
+  cv::Vec3d centroid(0, 0, 0);
+  std::size_t count = 0;
+  for (std::size_t b = 0; b < boards.size(); ++b) {
+    poses.push_back(rigid(boards[b]));
+    for (const auto& c : corners[b]) {
+      points[b].push_back(poses[b].R * cv::Vec3d(c[0], c[1], c[2]) + poses[b].t);
+      centroid += points[b].back();
+      ++count;
+    }
+  }
+  if (count < 3) throw std::invalid_argument("fit_floor: fewer than 3 corners");
+  centroid *= 1.0 / static_cast<double>(count);
+  cv::Matx33d scatter = cv::Matx33d::zeros();
+  for (const auto& board : points)
+    for (const cv::Vec3d& p : board) scatter += (p - centroid) * (p - centroid).t();
+  cv::Mat w, u, vt;
+  cv::SVD::compute(cv::Mat(scatter), w, u, vt);
+  if (!(w.at<double>(1) > 1e-12 * w.at<double>(0)))
+    throw std::invalid_argument("fit_floor: the corners lie on one line");
+  cv::Vec3d up(u.at<double>(0, 2), u.at<double>(1, 2), u.at<double>(2, 2));
+  // A board lying face up: its z points into the floor.
+  const cv::Vec3d first_up = -column(poses[0].R, 2);
+  if (up.dot(first_up) < 0) up = -up;
+  const cv::Vec3d origin = poses[0].t - up * up.dot(poses[0].t - centroid);
+  cv::Vec3d x = column(poses[0].R, 0);
+  x = cv::normalize(x - up * up.dot(x));
+  const cv::Vec3d y = up.cross(x);
+  Rigid world;
+  world.R = cv::Matx33d(x[0], x[1], x[2], y[0], y[1], y[2], up[0], up[1], up[2]);
+  world.t = -(world.R * origin);
+
+  FloorFit fit;
+  fit.world_from_bundle = pose_of(world);
+  for (std::size_t b = 0; b < boards.size(); ++b) {
+    double off = 0.0;
+    for (const cv::Vec3d& p : points[b]) off = std::max(off, std::abs(up.dot(p - centroid)));
+    fit.max_off_m.push_back(off);
+    const double cosine = std::clamp(-up.dot(column(poses[b].R, 2)), -1.0, 1.0);
+    fit.tilt_deg.push_back(std::acos(cosine) * 180.0 / std::acos(-1.0));
+  }
+  return fit;
+}
+
+}  // namespace rig_calibration_detail
 
 std::vector<CameraBoardViews> find_rig_board(const std::vector<std::string>& views,
                                              const std::vector<std::string>& names,
@@ -509,22 +600,29 @@ RigCalibration calibrate_rig(const std::vector<CameraBoardViews>& all_views,
   }
   report(options, "bundle adjustment", 1.0);
 
-  // The floor frame.
-  int floor = options.floor_frame;
-  if (floor < 0) {
-    floor = static_cast<int>(frame_of_board.front());
-  } else if (static_cast<std::size_t>(floor) >= frames ||
-             !board_index[static_cast<std::size_t>(floor)]) {
-    throw InputError("floor frame " + std::to_string(floor),
-                     static_cast<std::size_t>(floor) >= frames
-                         ? "the views have " + std::to_string(frames) + " frames"
-                         : "no camera of the rig saw the board in this frame (try every frame: "
-                           "step 1)");
+  // The floor frames, and the world from their boards.
+  const std::vector<std::size_t> floors = floor_frames_of(options, board_index, frame_of_board);
+  std::vector<Pose> floor_boards;
+  std::vector<std::vector<std::array<double, 3>>> floor_corners;
+  for (std::size_t f : floors) {
+    floor_boards.push_back(problem.board_poses[*board_index[f]]);
+    floor_corners.push_back(distinct_corners(problem, *board_index[f]));
   }
-  const Rigid world_from_old =
-      world_from_floor_board() *
-      rigid(problem.board_poses[*board_index[static_cast<std::size_t>(floor)]]).inverse();
-  const Rigid old_from_world = world_from_old.inverse();
+  const FloorFit fit = fit_floor(floor_boards, floor_corners);
+  const Rigid old_from_world = rigid(fit.world_from_bundle).inverse();
+  for (std::size_t i = 0; i < floors.size(); ++i) {
+    const FloorFrameReport r{static_cast<int>(floors[i]), static_cast<int>(floor_corners[i].size()),
+                             1000 * fit.max_off_m[i], fit.tilt_deg[i]};
+    result.floor_frames.push_back(r);
+    if (r.max_off_mm > kFloorToleranceMm) {
+      std::ostringstream note;
+      note << std::fixed << std::setprecision(1) << "floor frame " << r.frame
+           << ": its board lies up to " << r.max_off_mm << " mm off the plane of the floor frames"
+           << " (tilted " << r.tilt_deg << " degrees): is it flat on the floor?";
+      result.notes.push_back(note.str());
+    }
+  }
+  const int floor = static_cast<int>(floors.front());
 
   // The rig and its report.
   double all_squared = 0.0;

@@ -11,8 +11,10 @@
 //   4. one bundle adjustment (Ceres, rig_bundle_adjustment.cpp) over all camera poses and board
 //      poses (the intrinsics too with `refine_intrinsics`); observations whose error exceeds
 //      `outlier_factor` x the median are dropped and the solve repeated;
-//   5. the world from the board lying on the floor in `floor_frame`: origin at the board's origin,
-//      x along the board's x, z up (away from the floor), metres from the square size.
+//   5. the world from the board lying on the floor in `floor_frame`, or in each of `floor_frames`
+//      (slid and turned on the floor between them): the floor plane fitted to all their corners
+//      in the bundle's frame, origin at the first one's origin and x along its x (both projected
+//      onto the plane), z up (away from the floor), metres from the square size.
 
 #include <array>
 #include <cstddef>
@@ -68,8 +70,13 @@ struct RigBoardOptions {
   double outlier_factor = 3.0;  // drop observations with error > factor x median, re-solve
   int outlier_rounds = 2;
   // The frame in which the board lies flat on the floor; -1: the first frame in which any
-  // camera of the rig sees the board.
+  // camera of the rig sees the board. Ignored when floor_frames is given.
   int floor_frame = -1;
+  // Several frames of the board lying flat on the floor, slid and turned between them: the floor
+  // plane is fitted to the corners of all of them (one board seen at a grazing angle tilts the
+  // whole world; boards spread over the floor fix the plane by their spread), the origin and x
+  // axis come from the first. Empty: floor_frame alone.
+  std::vector<int> floor_frames;
   double board_thickness_mm = 0.0;  // the floor is this far below the board's face
   // Cameras that share no frame with the others: refused (InputError naming them), or with
   // `drop_unconnected` left out of the rig (RigCalibration::notes says which).
@@ -87,10 +94,19 @@ struct CameraCalibrationReport {
   double intrinsics_rms_px = 0.0;  // of its own intrinsic calibration (0 when given)
 };
 
+// How one floor frame's board lies on the fitted floor plane.
+struct FloorFrameReport {
+  int frame = 0;
+  int corners = 0;          // distinct board corners seen in it (by any camera)
+  double max_off_mm = 0.0;  // its corner farthest from the plane
+  double tilt_deg = 0.0;    // between its board's normal and the plane's
+};
+
 struct RigCalibration {
   Rig rig;                                       // cameras in view order, world and floor
   std::vector<CameraCalibrationReport> cameras;  // the same order
-  int floor_frame = 0;
+  int floor_frame = 0;                           // the first floor frame (origin and x axis)
+  std::vector<FloorFrameReport> floor_frames;    // every floor frame, floor_frame first
   int frames_used = 0;             // frames with the board in at least one camera of the rig
   double rms_px = 0.0;             // over all corners used
   std::vector<std::string> notes;  // what a user should know (cameras left out, ...)
@@ -107,9 +123,10 @@ std::vector<CameraBoardViews> find_rig_board(const std::vector<std::string>& vie
 
 // Calibrates the rig from the boards found. Throws InputError naming the camera when the board was
 // never (or too rarely, without intrinsics) found in it, with the number of frames tried; naming
-// the cameras that share no frame with the others (unless drop_unconnected); naming the floor
-// frame when no camera saw the board there; naming a camera missing from options.intrinsics or
-// whose size differs there.
+// the cameras that share no frame with the others (unless drop_unconnected); naming a floor
+// frame that no camera saw the board in, or listed twice; naming a camera missing from
+// options.intrinsics or whose size differs there. A floor frame whose board lies more than
+// kFloorToleranceMm off the fitted plane gets a note (is it on the floor?).
 RigCalibration calibrate_rig(const std::vector<CameraBoardViews>& views,
                              const RigBoardOptions& options);
 
@@ -117,6 +134,11 @@ RigCalibration calibrate_rig(const std::vector<CameraBoardViews>& views,
 RigCalibration calibrate_rig_from_board(const std::vector<std::string>& views,
                                         const std::vector<std::string>& names,
                                         const RigBoardOptions& options);
+
+// Farther off the floor plane than this, a floor frame's board gets a note. Chosen a priori, not
+// on the benchmark: several times the 1-2 mm to which a board's pose is found 2-3 m away, less
+// than a board lifted off the floor by a hand.
+inline constexpr double kFloorToleranceMm = 10.0;
 
 // Pieces, public for the tests.
 namespace rig_calibration_detail {
@@ -177,6 +199,20 @@ struct BundleProblem {
 // active corner, then of each active sighting, in `errors` (corners.size() + sightings.size();
 // inactive: NaN).
 void bundle_adjust(BundleProblem& problem, std::vector<double>& errors);
+
+// The world from boards lying flat on the floor: `boards` their poses (board -> the bundle's
+// frame), `corners` the board points seen in each (board frame, metres, z = 0). The floor plane is
+// the least-squares plane through all the corners (each counted once per board), its normal
+// turned to the side the first board's face looks at; the origin is the first board's origin and
+// x its x axis, both projected onto the plane; z up. Throws std::invalid_argument when the
+// corners do not span a plane (fewer than 3, or all on one line).
+struct FloorFit {
+  Pose world_from_bundle;
+  std::vector<double> max_off_m;  // per board: its corner farthest from the plane
+  std::vector<double> tilt_deg;   // per board: its normal against the plane's
+};
+FloorFit fit_floor(const std::vector<Pose>& boards,
+                   const std::vector<std::vector<std::array<double, 3>>>& corners);
 
 // One outlier round: deactivates the corners and sightings whose error exceeds
 // max(factor x the median error, floor_px); whether any was.

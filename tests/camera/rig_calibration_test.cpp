@@ -1,8 +1,9 @@
 // Calibrating a rig from a board (camera/rig_calibration.hpp) on SYNTHETIC renders: four virtual
 // cameras around a 4 m room, a ChArUco board in a few places (support/virtual_rig.hpp), the truth
 // known. Small images and few frames, so it takes seconds; tools/bench/rig_board_bench.cpp has the
-// full 4- and 8-camera tables. Then the bad inputs: a board never found, a camera that shares no
-// frame, views of different lengths, unreadable views, an intrinsics rig without a camera.
+// full 4- and 8-camera tables. The world from several floor frames. Then the bad inputs: a board
+// never found, a camera that shares no frame, views of different lengths, unreadable views, an
+// intrinsics rig without a camera, floor frames without the board, listed twice or in the air.
 
 #include "camera/rig_calibration.hpp"
 
@@ -13,6 +14,7 @@
 #include <iostream>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -41,16 +43,19 @@ std::vector<std::string> names_of(const std::vector<Camera>& cameras) {
   return names;
 }
 
-// Four cameras, eight frames, rendered once for every test here.
+// Four cameras, 16 frames and two more of the board on the floor, rendered once for every test
+// here.
 class RigCalibration : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     dir_ = std::make_unique<test::TempDir>();
     room_.cameras = 4;
     room_.frames = 16;
+    room_.floor_frames = 3;
     room_.seed = 3;
     room_.width = 960;
     room_.height = 540;
+    frames_ = room_.frames + room_.floor_frames - 1;
     truth_ = test::make_virtual_rig(room_);
     folders_ = test::render_virtual_rig(truth_, room_, dir_->path());
     options_.board = room_.board;
@@ -63,6 +68,7 @@ class RigCalibration : public ::testing::Test {
 
   static inline std::unique_ptr<test::TempDir> dir_;
   static inline test::VirtualRoom room_;
+  static inline int frames_ = 0;  // every frame rendered
   static inline test::VirtualRig truth_;
   static inline std::vector<std::string> folders_;
   static inline RigBoardOptions options_;
@@ -76,7 +82,7 @@ TEST_F(RigCalibration, RecoversFourCamerasAndTheFloor) {
       found += views_[k].boards[f].has_value();
       shown += truth_.seen[k][f];
     }
-    EXPECT_EQ(views_[k].frames, room_.frames);
+    EXPECT_EQ(views_[k].frames, frames_);
     // The detector may miss an oblique board, never invent one.
     EXPECT_LE(found, shown) << views_[k].name;
     EXPECT_GE(found, 2) << views_[k].name;
@@ -169,7 +175,7 @@ TEST_F(RigCalibration, ABoardNeverFoundNamesTheCameraAndTheFramesTried) {
   // A fifth camera whose folder shows an empty room.
   const fs::path empty = dir_->path() / "empty";
   fs::create_directories(empty);
-  for (int f = 0; f < room_.frames; ++f)
+  for (int f = 0; f < frames_; ++f)
     cv::imwrite((empty / ("frame_" + std::to_string(100 + f) + ".png")).string(),
                 cv::Mat(room_.height, room_.width, CV_8U, cv::Scalar(110)));
   // Two views are enough to say it (and quicker to read).
@@ -187,9 +193,8 @@ TEST_F(RigCalibration, ABoardNeverFoundNamesTheCameraAndTheFramesTried) {
     const std::string what = e.what();
     EXPECT_NE(what.find("cam_05"), std::string::npos) << what;
     EXPECT_NE(what.find(empty.string()), std::string::npos) << what;
-    EXPECT_NE(
-        what.find("not found in any of the " + std::to_string(room_.frames) + " frames tried"),
-        std::string::npos)
+    EXPECT_NE(what.find("not found in any of the " + std::to_string(frames_) + " frames tried"),
+              std::string::npos)
         << what;
   }
 }
@@ -197,7 +202,7 @@ TEST_F(RigCalibration, ABoardNeverFoundNamesTheCameraAndTheFramesTried) {
 TEST_F(RigCalibration, ViewsOfDifferentLengthsAreRefusedWithTheirCounts) {
   const fs::path shorter = dir_->path() / "shorter";
   fs::create_directories(shorter);
-  for (int f = 0; f + 1 < room_.frames; ++f) {
+  for (int f = 0; f + 1 < frames_; ++f) {
     char name[32];
     std::snprintf(name, sizeof name, "frame_%03d.png", f);
     fs::copy_file(fs::path(folders_[1]) / name, shorter / name,
@@ -210,10 +215,10 @@ TEST_F(RigCalibration, ViewsOfDifferentLengthsAreRefusedWithTheirCounts) {
   } catch (const InputError& e) {
     const std::string what = e.what();
     EXPECT_NE(what.find("different frame counts"), std::string::npos) << what;
-    EXPECT_NE(what.find("cam_02 (" + shorter.string() + ") " + std::to_string(room_.frames - 1)),
+    EXPECT_NE(what.find("cam_02 (" + shorter.string() + ") " + std::to_string(frames_ - 1)),
               std::string::npos)
         << what;
-    EXPECT_NE(what.find("cam_01 (" + folders_[0] + ") " + std::to_string(room_.frames)),
+    EXPECT_NE(what.find("cam_01 (" + folders_[0] + ") " + std::to_string(frames_)),
               std::string::npos)
         << what;
   }
@@ -272,10 +277,140 @@ TEST_F(RigCalibration, AFloorFrameWithoutTheBoardIsNamed) {
     FAIL() << "floor frame 99 was accepted";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("floor frame 99: the views have " +
-                                         std::to_string(room_.frames) + " frames"),
+                                         std::to_string(frames_) + " frames"),
               std::string::npos)
         << e.what();
   }
+}
+
+// The world from every floor frame: the plane through all their corners. Each board lies within a
+// few millimetres of it, the cameras' heights above the floor and their poses come out as with the
+// one floor frame or better, and origin and x are the first frame's.
+TEST_F(RigCalibration, SeveralFloorFramesSetTheFloorTogether) {
+  std::vector<int> floors;
+  for (int f : test::floor_frame_indices(room_))
+    if (std::any_of(views_.begin(), views_.end(), [&](const auto& v) {
+          return v.boards[static_cast<std::size_t>(f)].has_value();
+        }))
+      floors.push_back(f);
+  ASSERT_GE(floors.size(), 2u) << "the board on the floor is seen in fewer than 2 frames";
+  RigBoardOptions options = options_;
+  options.floor_frames = floors;
+  const camera::RigCalibration several = calibrate_rig(views_, options);
+  const camera::RigCalibration one = calibrate_rig(views_, options_);
+  EXPECT_EQ(several.floor_frame, 0);
+  ASSERT_EQ(several.floor_frames.size(), floors.size());
+  ASSERT_EQ(one.floor_frames.size(), 1u);
+  EXPECT_NEAR(one.floor_frames[0].max_off_mm, 0.0, 1e-6);  // one board: the plane is its own
+  for (std::size_t i = 0; i < floors.size(); ++i) {
+    const FloorFrameReport& f = several.floor_frames[i];
+    std::cout << "floor frame " << f.frame << ": " << f.corners << " corners, " << f.max_off_mm
+              << " mm off the plane, tilted " << f.tilt_deg << " deg\n";
+    EXPECT_EQ(f.frame, floors[i]);
+    EXPECT_GE(f.corners, options.min_corners);
+    EXPECT_LT(f.max_off_mm, kFloorToleranceMm);
+    EXPECT_LT(f.tilt_deg, 0.5);
+  }
+  EXPECT_TRUE(several.notes.empty());
+  double worst_height_one = 0, worst_height_several = 0;
+  for (std::size_t k = 0; k < 4; ++k) {
+    const Camera& want = truth_.cameras[k];
+    const Camera& got = several.rig.cameras[k];
+    const double height_mm = 1000 * std::abs(got.centre().z - want.centre().z);
+    worst_height_several = std::max(worst_height_several, height_mm);
+    worst_height_one = std::max(worst_height_one,
+                                1000 * std::abs(one.rig.cameras[k].centre().z - want.centre().z));
+    const double mm = 1000.0 * glm::length(got.centre() - want.centre());
+    std::cout << got.name << ": " << floors.size() << " floor frames: " << mm << " mm ("
+              << height_mm << " in height), " << rotation_error_deg(got.rotation, want.rotation)
+              << " deg; floor frame 0 alone: "
+              << 1000.0 * glm::length(one.rig.cameras[k].centre() - want.centre()) << " mm\n";
+    EXPECT_LT(mm, 10.0) << got.name;
+    EXPECT_LT(rotation_error_deg(got.rotation, want.rotation), 0.3) << got.name;
+  }
+  EXPECT_LT(worst_height_several, 5.0);
+  EXPECT_LT(worst_height_several, worst_height_one + 1.0);
+}
+
+TEST_F(RigCalibration, FloorFramesInTheAirOrListedTwiceAreNamed) {
+  // Frame 1: the board held up in the room, not on the floor.
+  std::size_t air = 1;
+  while (air < static_cast<std::size_t>(room_.frames) &&
+         !std::any_of(views_.begin(), views_.end(),
+                      [&](const auto& v) { return v.boards[air].has_value(); }))
+    ++air;
+  ASSERT_LT(air, static_cast<std::size_t>(room_.frames)) << "the board is never seen in the air";
+  RigBoardOptions options = options_;
+  options.floor_frames = {0, static_cast<int>(air)};
+  const camera::RigCalibration result = calibrate_rig(views_, options);
+  // Two boards, one plane through both: each is off it, the one in the air is named.
+  for (const std::string& n : result.notes) std::cout << "note: " << n << "\n";
+  const std::string note = "floor frame " + std::to_string(air) + ": its board lies";
+  EXPECT_TRUE(std::any_of(result.notes.begin(), result.notes.end(), [&](const std::string& n) {
+    return n.rfind(note, 0) == 0;
+  })) << (result.notes.empty() ? "no note" : result.notes[0]);
+  EXPECT_GT(result.floor_frames.at(1).max_off_mm, kFloorToleranceMm);
+
+  for (const std::vector<int>& bad : {std::vector<int>{0, 0}, std::vector<int>{0, 99}}) {
+    options.floor_frames = bad;
+    try {
+      calibrate_rig(views_, options);
+      ADD_FAILURE() << "floor frames " << bad[0] << "," << bad[1] << " were accepted";
+    } catch (const InputError& e) {
+      const std::string what = e.what();
+      EXPECT_EQ(what.rfind("floor frame " + std::to_string(bad[1]) + ": ", 0), 0u) << what;
+      EXPECT_NE(what.find(bad[1] == 0 ? "listed twice" : "the views have"), std::string::npos)
+          << what;
+    }
+  }
+}
+
+// The plane alone, on exact board poses: three boards flat on a floor seen from a turned and
+// shifted frame, then boards whose corners lie on one line.
+TEST(RigFloorFit, ThePlaneThroughEveryBoardWithTheFirstBoardsOriginAndAxis) {
+  using namespace rig_calibration_detail;
+  const cv::Matx33d face_up(1, 0, 0, 0, -1, 0, 0, 0, -1);  // board -> world, lying face up
+  const auto turn = [](double yaw) {
+    return cv::Matx33d(std::cos(yaw), -std::sin(yaw), 0, std::sin(yaw), std::cos(yaw), 0, 0, 0, 1);
+  };
+  // bundle <- world: any rigid motion.
+  cv::Matx33d bundle_R;
+  cv::Rodrigues(cv::Vec3d(0.4, -1.1, 0.7), bundle_R);
+  const cv::Vec3d bundle_t(0.3, -2.0, 4.5);
+  const std::vector<std::pair<double, cv::Vec3d>> boards_in_world{
+      {0.0, {0, 0, 0}}, {1.3, {1.2, -0.4, 0}}, {-2.0, {-0.7, 0.9, 0}}};
+  std::vector<Pose> boards;
+  std::vector<std::vector<std::array<double, 3>>> corners;
+  for (const auto& [yaw, origin] : boards_in_world) {
+    const cv::Matx33d R = bundle_R * turn(yaw) * face_up;
+    cv::Vec3d r;
+    cv::Rodrigues(R, r);
+    const cv::Vec3d t = bundle_R * origin + bundle_t;
+    boards.push_back({{r[0], r[1], r[2]}, {t[0], t[1], t[2]}});
+    corners.push_back({{0.1, 0.1, 0}, {0.5, 0.1, 0}, {0.1, 0.3, 0}, {0.5, 0.3, 0}});
+  }
+  const FloorFit fit = fit_floor(boards, corners);
+  cv::Matx33d R;
+  cv::Rodrigues(cv::Vec3d(fit.world_from_bundle.rotation[0], fit.world_from_bundle.rotation[1],
+                          fit.world_from_bundle.rotation[2]),
+                R);
+  const cv::Vec3d t(fit.world_from_bundle.translation[0], fit.world_from_bundle.translation[1],
+                    fit.world_from_bundle.translation[2]);
+  // world <- bundle <- world: the identity.
+  const cv::Matx33d round = R * bundle_R;
+  const cv::Vec3d shift = R * bundle_t + t;
+  for (int r = 0; r < 3; ++r) {
+    EXPECT_NEAR(shift[r], 0.0, 1e-9);
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(round(r, c), r == c ? 1.0 : 0.0, 1e-9);
+  }
+  for (std::size_t b = 0; b < boards.size(); ++b) {
+    EXPECT_NEAR(fit.max_off_m[b], 0.0, 1e-9);
+    EXPECT_NEAR(fit.tilt_deg[b], 0.0, 1e-6);
+  }
+
+  // One board, its corners on a line: no plane.
+  corners = {{{0.1, 0.1, 0}, {0.3, 0.1, 0}, {0.5, 0.1, 0}}};
+  EXPECT_THROW(fit_floor({boards[0]}, corners), std::invalid_argument);
 }
 
 }  // namespace

@@ -3,7 +3,9 @@
 // the room looking at its centre, a ChArUco board moved through the space (frame 0: lying flat on
 // the floor at the world origin), every view rendered with support/board_render.hpp (blur and
 // noise) into one folder of PNGs per camera. World: z up, floor z = 0, metres; the floor board's
-// frame is the world as `mocap calibrate rig` defines it (x along the board, z up).
+// frame is the world as `mocap calibrate rig` defines it (x along the board, z up). With
+// `floor_frames` > 1 the board lies on the floor again after the frames in the air, slid to other
+// spots and turned, as a user filming several floor frames would (floor_frame_indices()).
 
 #include <cmath>
 #include <cstdio>
@@ -25,6 +27,12 @@ namespace mocap::test {
 struct VirtualRoom {
   int cameras = 4;
   int frames = 12;  // frame 0 is the board on the floor
+  // Frames of the board lying on the floor: frame 0, then floor_frames - 1 more after the
+  // `frames` frames (so the frames before are the same with any value), the board's centre
+  // floor_spot_radius_m from the room's centre at evenly spread directions (a random start) and
+  // turned at random about the vertical. From a generator of their own.
+  int floor_frames = 1;
+  double floor_spot_radius_m = 0.8;
   int width = 640, height = 360;
   double hfov_deg = 70.0;
   double ring_radius_m = 2.2;  // cameras stand 2.0 .. 2.6 m from the centre (a 4 m room)
@@ -45,6 +53,13 @@ struct VirtualRig {
   std::vector<BoardPlacement> boards;   // per frame
   std::vector<std::vector<bool>> seen;  // [camera][frame]: the board was rendered in view
 };
+
+// The frames in which the board lies on the floor: 0, then those after room.frames.
+inline std::vector<int> floor_frame_indices(const VirtualRoom& room) {
+  std::vector<int> out{0};
+  for (int j = 1; j < room.floor_frames; ++j) out.push_back(room.frames + j - 1);
+  return out;
+}
 
 inline glm::dmat3 look_at(const glm::dvec3& from, const glm::dvec3& to) {
   const glm::dvec3 z = glm::normalize(to - from);
@@ -91,6 +106,20 @@ inline VirtualRig make_virtual_rig(const VirtualRoom& room) {
     const glm::dvec3 y = glm::cross(z, x);
     const glm::dvec3 centre(0.6 * unit(rng), 0.6 * unit(rng), 1.0 + 0.5 * unit(rng));
     const glm::dmat3 rotation(x, y, z);
+    rig.boards.push_back({rotation, centre - rotation * glm::dvec3(w / 2, h / 2, 0)});
+  }
+  std::mt19937 floor_rng(room.seed + 2);
+  std::uniform_real_distribution<double> turn(0.0, 2 * pi);
+  const double start = turn(floor_rng);
+  for (int j = 1; j < room.floor_frames; ++j) {
+    // Face up (z into the floor), turned by `yaw` about the vertical.
+    const double direction = start + 2 * pi * (j - 1) / (room.floor_frames - 1);
+    const double yaw = turn(floor_rng);
+    const glm::dvec3 x(std::cos(yaw), std::sin(yaw), 0.0);
+    const glm::dvec3 z(0, 0, -1);
+    const glm::dmat3 rotation(x, glm::cross(z, x), z);
+    const glm::dvec3 centre(room.floor_spot_radius_m * std::cos(direction),
+                            room.floor_spot_radius_m * std::sin(direction), 0.0);
     rig.boards.push_back({rotation, centre - rotation * glm::dvec3(w / 2, h / 2, 0)});
   }
   return rig;

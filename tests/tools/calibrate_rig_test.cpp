@@ -1,8 +1,9 @@
 // `mocap calibrate rig` driven as a user would: the built binary in a child process, on
 // SYNTHETIC renders of a ChArUco board seen by four virtual cameras (support/virtual_rig.hpp),
-// the intrinsics given as a rig file. The library's accuracy and its bad inputs are in
-// tests/camera/rig_calibration_test.cpp; here: the command's table, the file it writes, and its
-// messages for an intrinsics rig without a camera and for an unreadable view.
+// the intrinsics given as a rig file, the world from two floor frames. The library's accuracy and
+// its bad inputs are in tests/camera/rig_calibration_test.cpp; here: the command's table, the file
+// it writes, and its messages for an intrinsics rig without a camera, for an unreadable view and
+// for --floor-frame with --floor-frames.
 
 #include <filesystem>
 #include <iostream>
@@ -33,6 +34,7 @@ TEST(CalibrateRigCommand, WritesTheRigOfFourVirtualCameras) {
   room.width = 960;
   room.height = 540;
   room.seed = 5;
+  room.floor_frames = 2;  // frame 10: the board on the floor again, elsewhere
   test::VirtualRig truth = test::make_virtual_rig(room);
   const std::vector<std::string> views =
       test::render_virtual_rig(truth, room, dir.path() / "views");
@@ -44,14 +46,16 @@ TEST(CalibrateRigCommand, WritesTheRigOfFourVirtualCameras) {
                              "--marker", "110", "--intrinsics"})
     command.emplace_back(option);
   command.push_back(dir.file("lenses.toml"));
+  command.emplace_back("--floor-frames");
+  command.emplace_back("0,10");
   command.emplace_back("--out");
   command.push_back(dir.file("rig.toml"));
   test::Mocap run(dir, "rig", command);
   ASSERT_EQ(run.wait(120s), 0) << run.err();
   const std::string out = run.out();
   std::cout << out;
-  for (const char* text : {"ChArUco 6x4 squares of 150 mm", "the floor from frame 0", "| cam_04 |",
-                           "RMS reprojection error", "wrote"})
+  for (const char* text : {"ChArUco 6x4 squares of 150 mm", "the floor from frames 0 (", " 10 (",
+                           "| cam_04 |", "RMS reprojection error", "wrote"})
     EXPECT_NE(out.find(text), std::string::npos) << text << "\n" << out;
   const camera::Rig rig = camera::read_rig(dir.file("rig.toml"));
   ASSERT_EQ(rig.cameras.size(), 4u);
@@ -67,7 +71,7 @@ TEST(CalibrateRigCommand, WritesTheRigOfFourVirtualCameras) {
   camera::write_rig(
       dir.file("three.toml"),
       camera::Rig{{truth.cameras[0], truth.cameras[1], truth.cameras[2]}, std::nullopt});
-  command[command.size() - 3] = dir.file("three.toml");
+  command[command.size() - 5] = dir.file("three.toml");
   test::Mocap missing(dir, "missing", command);
   EXPECT_NE(missing.wait(60s), 0);
   EXPECT_NE(missing.err().find(dir.file("three.toml") + ": has 3 cameras, no camera for view 4 (" +
@@ -76,13 +80,23 @@ TEST(CalibrateRigCommand, WritesTheRigOfFourVirtualCameras) {
       << missing.err();
 
   // A view that is not there is named.
-  command[command.size() - 3] = dir.file("lenses.toml");
+  command[command.size() - 5] = dir.file("lenses.toml");
   command[3] = dir.file("nowhere");
   test::Mocap unreadable(dir, "unreadable", command);
   EXPECT_NE(unreadable.wait(60s), 0);
   EXPECT_NE(unreadable.err().find(dir.file("nowhere") + ": no such file or folder (camera cam_02)"),
             std::string::npos)
       << unreadable.err();
+
+  // One floor frame or several, not both.
+  command[3] = views[1];
+  command.emplace_back("--floor-frame");
+  command.emplace_back("0");
+  test::Mocap both(dir, "both", command);
+  EXPECT_NE(both.wait(60s), 0);
+  EXPECT_NE(both.err().find("--floor-frames: give --floor-frame or --floor-frames, not both"),
+            std::string::npos)
+      << both.err();
 }
 
 // From people: Pose2Sim's static trial (one person standing still, 12 frames) is refused with the

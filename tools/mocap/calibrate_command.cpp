@@ -667,6 +667,13 @@ int rig_people_command(int argc, char** argv) {
   return 0;
 }
 
+// Frame numbers, comma-separated, each a whole number >= 0.
+Range frame_list_range() {
+  Range r = Range::count(0);
+  r.list = true;
+  return r;
+}
+
 int rig_board_command(int argc, char** argv) {
   for (int i = 0; i < argc; ++i)
     if (std::string_view(argv[i]) == "--from-people") return rig_people_command(argc, argv);
@@ -682,8 +689,9 @@ int rig_board_command(int argc, char** argv) {
       "adjustment (dropping\ncorners off by more than "
       "--outlier x the median and solving again), and sets the world from\nthe board lying "
       "on the floor in --floor-frame: origin at the board's origin, x along the board,\nz up, "
-      "metres from --square. Prints each camera's RMS reprojection error and writes the rig\n"
-      "(.toml: Pose2Sim/anipose layout; .yml: OpenCV YAML; docs/cameras.md).");
+      "metres from --square; or from --floor-frames: the floor plane through the corners of\n"
+      "all of them, origin and x from the first. Prints each camera's RMS reprojection error and\n"
+      "writes the rig (.toml: Pose2Sim/anipose layout; .yml: OpenCV YAML; docs/cameras.md).");
   args.positional("views", "a video or a folder of images per camera, in the rig's order", true);
   board_options(args);
   args.option("cameras", "NAMES",
@@ -707,6 +715,12 @@ int rig_board_command(int argc, char** argv) {
               "the frame in which the board lies flat on the floor (default: the first frame in "
               "which a camera sees the board)",
               std::nullopt, Range::count(0))
+      .option("floor-frames", "N,N,...",
+              "several frames of the board lying flat on the floor, slid and turned between "
+              "them (instead of --floor-frame): the floor plane is fitted to all their corners "
+              "(a board seen at a grazing angle tilts the world less), origin and x from the "
+              "first; a frame whose board lies over 10 mm off that plane gets a note",
+              std::nullopt, frame_list_range())
       .option("thickness", "MM", "thickness of the board: the floor lies this far below it", "0",
               Range::at_least(0))
       .option("step", "N", "search every Nth frame of each view", "1", Range::count(1))
@@ -732,6 +746,12 @@ int rig_board_command(int argc, char** argv) {
   options.board_thickness_mm = args.number("thickness");
   options.drop_unconnected = args.has("drop-unconnected");
   if (args.has("floor-frame")) options.floor_frame = static_cast<int>(args.integer("floor-frame"));
+  if (args.has("floor-frames")) {
+    if (args.has("floor-frame"))
+      throw InputError("--floor-frames", "give --floor-frame or --floor-frames, not both");
+    for (double frame : args.numbers("floor-frames"))
+      options.floor_frames.push_back(static_cast<int>(frame));
+  }
   if (args.has("out")) camera::rig_format_for_writing(args.get("out"));  // a bad name fails now
 
   std::vector<std::string> names;
@@ -768,8 +788,15 @@ int rig_board_command(int argc, char** argv) {
   bar.finish();
 
   std::cout << "board " << camera::describe(options.board) << "\n"
-            << result.frames_used << " frames with the board; the floor from frame "
-            << result.floor_frame << "\n";
+            << result.frames_used << " frames with the board; the floor from frame"
+            << (result.floor_frames.size() > 1 ? "s" : "");
+  for (const camera::FloorFrameReport& f : result.floor_frames) {
+    std::cout << " " << f.frame;
+    if (result.floor_frames.size() > 1)
+      std::cout << " (" << fixed(f.max_off_mm, 1) << " mm off the plane, tilted "
+                << fixed(f.tilt_deg, 2) << " deg)";
+  }
+  std::cout << "\n";
   for (const std::string& note : result.notes) std::cout << "note: " << note << "\n";
   std::cout << "\n| camera | frames with board | corners used | dropped | RMS px | fx | fy | cx | "
                "cy | position m |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---|\n";
