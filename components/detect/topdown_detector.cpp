@@ -33,6 +33,8 @@ void check(const TopDownOptions& o) {
   if (o.detector_tiles < 1) throw std::invalid_argument("detector_tiles must be at least 1");
   if (!(o.sure_box_score >= 0.0f && o.sure_box_score <= 1.0f))
     throw std::invalid_argument("sure_box_score must lie in [0, 1] (0: off)");
+  if (!(o.newcomer_agreement >= 0.0f && o.newcomer_agreement <= 1.0f))
+    throw std::invalid_argument("newcomer_agreement must lie in [0, 1] (0: off)");
   if (!(o.min_pose_presence >= 0.0f && o.min_pose_presence <= 1.0f))
     throw std::invalid_argument("min_pose_presence must lie in [0, 1]");
   if (!(o.small_box_height >= 0.0f) ||
@@ -277,8 +279,11 @@ void TopDownDetector::people_found(const ImageBuffer& frame, std::vector<Found>&
     }
     const CropVerdict verdict = judge_crop(found_[i], options_);
     person.score = verdict.score;
-    const bool posed = verdict.posed;
     const float box_score = box_scores_[i];
+    const bool agrees = options_.newcomer_agreement <= 0 || !newcomer_[i] ||
+                        iou(posed_box(found_[i], r, options_, frame.width(), frame.height()),
+                            crop_boxes_[i]) >= options_.newcomer_agreement;
+    const bool posed = verdict.posed && agrees;
     const bool sure = options_.sure_box_score > 0 && box_score >= options_.sure_box_score;
     if (!posed && !sure) continue;
     // Keypoints too unsure to outline the person: the detector's box does.
@@ -358,10 +363,12 @@ std::vector<MovenetPerson> TopDownDetector::detect(const ImageBuffer& frame) {
   carry(found);
   std::vector<Box2D> boxes;
   box_scores_.clear();
+  newcomer_.clear();
   for (std::size_t i = 0; i < followed_.size(); ++i) {
     if (carried_[i]) continue;
     boxes.push_back(moved(followed_[i].box, followed_[i].vx, followed_[i].vy));
     box_scores_.push_back(followed_[i].box_score);
+    newcomer_.push_back(0);
   }
   const bool run_detector =
       frame_ % options_.detect_every == 0 || lost_someone_ || followed_.empty();
@@ -414,6 +421,7 @@ std::vector<MovenetPerson> TopDownDetector::detect(const ImageBuffer& frame) {
       if (!known) {
         boxes.push_back(d.box);
         box_scores_.push_back(d.score);
+        newcomer_.push_back(1);
       }
     }
   }

@@ -85,6 +85,11 @@ struct TopDownOptions {
   // min_keypoint_score are kept, and the box is the detector's. Such a person is followed until
   // the next detector run, which keeps them only if it still finds them this sure. 0: off.
   float sure_box_score = 0.0f;
+  // A newcomer (a detector box nobody followed) is a person only when their posed box overlaps
+  // the detector's box by at least this IoU (0: off): a pose whose box disagrees with the box it
+  // was cropped for is on a neighbour or a mix of people in a row. 0.5 a priori: the IoU at which
+  // the evaluation and the detector's NMS call two boxes one person.
+  float newcomer_agreement = 0.0f;
   float duplicate_overlap = 0.6f;  // people whose boxes overlap more are one
   // The network runtime of both networks and their threads (graph_runner.hpp: XNNPACK's are each
   // network's own, 0 meaning one; cv::dnn's are process-wide, 0 its default).
@@ -222,8 +227,9 @@ class TopDownDetector {
   std::unique_ptr<OrderedWorkers<int>> helpers_;  // workers - 1 threads; none with one worker
   GraphTensor image_, crops_;  // the networks' inputs, reused from frame to frame
   std::vector<SquareRegion> regions_;
-  std::vector<Box2D> crop_boxes_;  // per crop of the frame: the box it was cut around
-  std::vector<float> box_scores_;  // per box of the frame: the detector's score of it
+  std::vector<Box2D> crop_boxes_;       // per crop of the frame: the box it was cut around
+  std::vector<float> box_scores_;       // per box of the frame: the detector's score of it
+  std::vector<std::uint8_t> newcomer_;  // per box of the frame: a detector box nobody followed
   std::vector<SinglePose> found_;
   std::vector<Followed> followed_;
   std::unique_ptr<KeypointFlow> flow_;  // with keypoint_every > 1

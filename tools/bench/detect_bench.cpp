@@ -101,7 +101,7 @@ Strategy make_strategy(const std::string& spec, detect::Backend backend, int thr
     } catch (const std::invalid_argument&) {
       throw std::invalid_argument(
           "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:kEVERY][:uSURE][:"
-          "bPRESENCE][:m0][:h1][:cH[xP]] with "
+          "bPRESENCE][:m0][:h1][:cH[xP]][:aIOU] with "
           "MODEL " +
           std::string(detect::pose_model_names()) + ", got " + spec);
     }
@@ -124,6 +124,8 @@ Strategy make_strategy(const std::string& spec, detect::Backend backend, int thr
         o.box_landmark_presence = std::stof(parts[i].substr(1));
       else if (parts[i] == "m0")
         o.anatomical_landmark_box = false;
+      else if (parts[i].size() > 1 && parts[i][0] == 'a')
+        o.newcomer_agreement = std::stof(parts[i].substr(1));
       else if (parts[i] == "h1")
         o.head_margin_from_shoulders = true;
       else if (parts[i].size() > 1 && parts[i][0] == 'c') {
@@ -139,7 +141,7 @@ Strategy make_strategy(const std::string& spec, detect::Backend backend, int thr
     if (numbers.size() > 2)
       throw std::invalid_argument(
           "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:kEVERY][:uSURE][:"
-          "bPRESENCE][:m0][:h1][:cH[xP]], got " +
+          "bPRESENCE][:m0][:h1][:cH[xP]][:aIOU], got " +
           spec);
     o.backend = backend;
     o.threads = numbers.size() == 2 ? std::stoi(numbers[1]) : threads;
@@ -154,7 +156,7 @@ Strategy make_strategy(const std::string& spec, detect::Backend backend, int thr
   throw std::invalid_argument("unknown strategy '" + spec +
                               "' (multipose:SIZE, tiles:CxR:TILE:FRAME, "
                               "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:"
-                              "kEVERY][:uSURE][:bPRESENCE][:m0][:h1][:cH[xP]])");
+                              "kEVERY][:uSURE][:bPRESENCE][:m0][:h1][:cH[xP]][:aIOU])");
 }
 
 // Every frame of a video, or the one image of a still.
@@ -330,10 +332,11 @@ json candidates(const std::string& input, const Run& reference, const std::vecto
 // Why each true person a top-down strategy missed was missed (--diagnose): its person detector
 // is run again on the annotated frames at the score floor `floor`, and each missed box is put in
 // one cause: (d) a person was found near it but their box matches at IoU < min_iou (nearest
-// IoU >= 0.3); (a) the detector proposed nothing near it (IoU >= 0.3) at any score >= floor; (b)
-// only below the strategy's threshold; (c) proposed above it, yet no person came out near it (the
-// keypoint stage rejected the crop, duplicate removal dropped it, or, between detector runs, no
-// crop was looked at there). Prints a Markdown table per strategy.
+// IoU >= 0.3 among the found boxes matched to no other true person: a neighbour's box is not
+// this person's loose box); (a) the detector proposed nothing near it (IoU >= 0.3) at any score >=
+// floor; (b) only below the strategy's threshold; (c) proposed above it, yet no person came out
+// near it (the keypoint stage rejected the crop, duplicate removal dropped it, or, between detector
+// runs, no crop was looked at there). Prints a Markdown table per strategy.
 void diagnose(const std::string& input, const eval::DetectionTruth& truth, const std::string& name,
               const Run& r, const detect::TopDownOptions& o, detect::Backend backend, int threads,
               float min_iou, float floor) {
@@ -415,9 +418,14 @@ void diagnose(const std::string& input, const eval::DetectionTruth& truth, const
         by_cause["found"][static_cast<std::size_t>(band)]++;
         continue;
       }
-      float near = 0, near_height = 0;
-      for (const Box2D& b : found)
-        if (const float v = detect::iou(b, box); v > near) near = v, near_height = b.height;
+      // The nearest found box, and the nearest of those matched to no other true person: a
+      // neighbour's box overlapping this one by 0.3-0.5 is not a loose box of this person.
+      float near = 0, free_near = 0, near_height = 0;
+      for (std::size_t j = 0; j < found.size(); ++j) {
+        const float v = detect::iou(found[j], box);
+        near = std::max(near, v);
+        if (score.match[j] < 0 && v > free_near) free_near = v, near_height = found[j].height;
+      }
       nearest[near < 0.1f ? 0 : near < 0.3f ? 1 : 2]++;
       float best_score = -1, best_iou = 0.3f;    // the best proposal near the box
       const detect::Detection* above = nullptr;  // the nearest passing the threshold
@@ -427,7 +435,7 @@ void diagnose(const std::string& input, const eval::DetectionTruth& truth, const
         best_score = std::max(best_score, d.score);
         if (d.score >= used.min_score && v >= best_iou) above = &d, best_iou = v;
       }
-      if (near >= 0.3f) {
+      if (free_near >= 0.3f) {
         count("(d) found, box IoU 0.3-0.5");
         const float ratio = near_height / box.height;
         loose[ratio < 0.9f ? 0 : ratio <= 1.1f ? 1 : 2]++;
@@ -451,7 +459,12 @@ void diagnose(const std::string& input, const eval::DetectionTruth& truth, const
         // A sure box is a person whatever its keypoints (TopDownOptions::sure_box_score).
         const bool sure = o.sure_box_score > 0 && above->score >= o.sure_box_score;
         const detect::CropVerdict verdict = detect::judge_crop(answer, o);
-        const bool posed = verdict.posed;
+        // A newcomer whose posed box disagrees with its proposal is rejected too (agreement).
+        const bool agrees =
+            o.newcomer_agreement <= 0 ||
+            detect::iou(detect::posed_box(answer, region, o, f->width(), f->height()),
+                        above->box) >= o.newcomer_agreement;
+        const bool posed = verdict.posed && agrees;
         if (!posed && !sure) {
           count("(c1) proposed, crop's keypoints rejected");
           rejected_score[static_cast<std::size_t>(
@@ -551,7 +564,7 @@ int main(int argc, char** argv) {
           "multipose:SIZE, "
           "tiles:CxR:TILE:FRAME, "
           "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:kEVERY][:"
-          "uSURE][:bPRESENCE][:m0][:h1][:cH[xP]] "
+          "uSURE][:bPRESENCE][:m0][:h1][:cH[xP]][:aIOU] "
           "(MODEL: lightning, thunder, blazepose-lite, blazepose-full, blazepose-heavy; "
           "workers: copies of the keypoint network sharing a frame's crops; tTILES: person "
           "detector tiles, tTILESw: and the whole frame, sSCORE: its box score floor, uSURE: "
@@ -560,7 +573,8 @@ int main(int argc, char** argv) {
           "keypoints), m0: that landmark box widened as the keypoints' and not cut to the "
           "picture (before the anatomical margins), h1: BlazePose's head margin at least 0.54 x "
           "the eyes' height above the shoulders, cH[xP]: boxes under H px get crops of "
-          "padding P (default 1.5), kEVERY: keypoint pass every "
+          "padding P (default 1.5), aIOU: a newcomer is a person only when its posed box overlaps "
+          "the detector's by this IoU, kEVERY: keypoint pass every "
           "EVERY "
           "frames, optical flow between; a top-down "
           "strategy also prints where its time went)",
@@ -673,6 +687,17 @@ int main(int argc, char** argv) {
                         {"frames_per_second", fps},
                         {"frames", runs[s].frames},
                         {"seconds", runs[s].seconds}});
+      }
+      // No cap on people (issue 18): how many frames show more than MultiPose's 6.
+      for (std::size_t s = 0; s < runs.size(); ++s) {
+        int crowded = 0;
+        std::size_t most = 0;
+        for (const auto& [frame, found] : runs[s].people) {
+          crowded += found.size() > 6 ? 1 : 0;
+          most = std::max(most, found.size());
+        }
+        std::printf("%s%s: %d of %d frames with more than 6 people found (at most %zu)\n",
+                    s == 0 ? "\n" : "", names[s].c_str(), crowded, runs[s].frames, most);
       }
       print_profiles(names, runs);
       std::fflush(stdout);
