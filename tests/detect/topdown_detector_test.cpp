@@ -337,6 +337,20 @@ TEST(TopDownDetector, BlazePoseFindsThePedestriansOfFrame300) {
   }
 }
 
+// newcomer_agreement: a newcomer is a person only when its posed box overlaps its detector box
+// by that IoU. At 0.99 no posed box agrees that closely, so the first frame of frame 300's
+// walkers (all newcomers; found with the option off in the tests above) finds nobody.
+TEST(TopDownDetector, NewcomersWhosePoseDisagreesWithTheirBoxAreNotPeople) {
+  std::string why;
+  const auto m = models(why);
+  if (!m) GTEST_SKIP() << why;
+  TopDownOptions o;
+  o.newcomer_agreement = 0.99f;
+  EXPECT_TRUE(TopDownDetector(o, m->lightning, m->centernet).detect(shifted_frame(0)).empty());
+  o.newcomer_agreement = 1.5f;
+  EXPECT_THROW(TopDownDetector(o, m->lightning, m->centernet), std::invalid_argument);
+}
+
 // Frames 0..5 of the moving picture with the keypoint network every frame, then every third.
 TEST(TopDownDetector, KeypointsCarriedByFlowStayWithTheNetworksBetweenPasses) {
   std::string why;
