@@ -33,8 +33,13 @@ void check(const TopDownOptions& o) {
   if (o.detector_tiles < 1) throw std::invalid_argument("detector_tiles must be at least 1");
   if (!(o.sure_box_score >= 0.0f && o.sure_box_score <= 1.0f))
     throw std::invalid_argument("sure_box_score must lie in [0, 1] (0: off)");
+  if (!(o.newcomer_agreement >= 0.0f && o.newcomer_agreement <= 1.0f))
+    throw std::invalid_argument("newcomer_agreement must lie in [0, 1] (0: off)");
   if (!(o.min_pose_presence >= 0.0f && o.min_pose_presence <= 1.0f))
     throw std::invalid_argument("min_pose_presence must lie in [0, 1]");
+  if (!(o.small_box_height >= 0.0f) ||
+      !(o.small_crop_padding >= 1.0f && o.small_crop_padding <= 4.0f))
+    throw std::invalid_argument("small_box_height must be >= 0 and small_crop_padding in [1, 4]");
   if (o.workers < 1 || o.workers > 16) throw std::invalid_argument("workers must lie in [1, 16]");
   if (o.keypoint_every < 1) throw std::invalid_argument("keypoint_every must be at least 1");
   if (!(o.flow_error > 0.0f && o.flow_error <= 1.0f))
@@ -93,7 +98,27 @@ CropVerdict judge_crop(const SinglePose& pose, const TopDownOptions& options) {
   return v;
 }
 
+SquareRegion crop_region(const Box2D& box, const TopDownOptions& options) {
+  const bool small = box.height < options.small_box_height;
+  return square_around(box, small ? options.small_crop_padding : options.crop_padding);
+}
+
 namespace {
+
+// BlazePose's landmarks (MediaPipe's order) that place the head above the shoulders.
+constexpr int kLeftEye = 2, kRightEye = 5, kLeftShoulder = 11, kRightShoulder = 12;
+
+// How far the eyes lie above the shoulders in the crop (its share of the crop's side), or 0 when
+// a landmark of either pair is absent or the shoulders are not below the eyes.
+float eyes_above_shoulders(const SinglePose& pose, float min_presence) {
+  if (pose.body_landmarks <= kRightShoulder) return 0;
+  const auto& b = pose.body;
+  for (const int k : {kLeftEye, kRightEye, kLeftShoulder, kRightShoulder})
+    if (b[static_cast<std::size_t>(k)][2] < min_presence) return 0;
+  const float eyes = (b[kLeftEye][0] + b[kRightEye][0]) / 2;
+  const float shoulders = (b[kLeftShoulder][0] + b[kRightShoulder][0]) / 2;
+  return std::max(0.0f, shoulders - eyes);
+}
 
 // The points a posed person's boxes span, in frame pixels: BlazePose's landmarks whose presence
 // reaches box_landmark_presence when at least two do, else the keypoints scoring
@@ -127,9 +152,20 @@ Box2D posed_box(const SinglePose& pose, const SquareRegion& region, const TopDow
   std::array<Keypoint2D, kBlazePoseBody> points{};
   const auto [count, landmarks] = posed_points(pose, region, options, points);
   const auto present = std::span(points).first(count);
-  if (landmarks && options.anatomical_landmark_box)
-    return clip_box(points_box(present, kLandmarkBoxMargins), static_cast<float>(frame_width),
-                    static_cast<float>(frame_height));
+  if (landmarks && options.anatomical_landmark_box) {
+    Box2D box = points_box(present, kLandmarkBoxMargins);
+    if (options.head_margin_from_shoulders) {
+      // The head's margin from the head's own size when that is more: legs out of the picture
+      // shorten the landmarks' extent, not the head.
+      const Box2D bare = points_box(present, {});
+      const float margin = kLandmarkBoxMargins.top * std::max(bare.width, bare.height);
+      const float head = kHeadAboveEyesPerEyeToShoulder * region.side *
+                         eyes_above_shoulders(pose, options.box_landmark_presence);
+      if (head > margin)
+        box = {box.x, box.y - (head - margin), box.width, box.height + head - margin};
+    }
+    return clip_box(box, static_cast<float>(frame_width), static_cast<float>(frame_height));
+  }
   return keypoint_box(present, kHeadMargin);
 }
 
@@ -221,7 +257,7 @@ void TopDownDetector::add_crops(const ImageBuffer& frame, std::span<const Box2D>
   const int first = static_cast<int>(found_.size());
   for (int i = 0; i < count; ++i) {
     crop_boxes_.push_back(boxes[static_cast<std::size_t>(i)]);
-    regions_.push_back(square_around(crop_boxes_.back(), options_.crop_padding));
+    regions_.push_back(crop_region(crop_boxes_.back(), options_));
     fill_region(frame, regions_.back(), crops_, i);
   }
   found_.resize(found_.size() + boxes.size());
@@ -243,8 +279,11 @@ void TopDownDetector::people_found(const ImageBuffer& frame, std::vector<Found>&
     }
     const CropVerdict verdict = judge_crop(found_[i], options_);
     person.score = verdict.score;
-    const bool posed = verdict.posed;
     const float box_score = box_scores_[i];
+    const bool agrees = options_.newcomer_agreement <= 0 || !newcomer_[i] ||
+                        iou(posed_box(found_[i], r, options_, frame.width(), frame.height()),
+                            crop_boxes_[i]) >= options_.newcomer_agreement;
+    const bool posed = verdict.posed && agrees;
     const bool sure = options_.sure_box_score > 0 && box_score >= options_.sure_box_score;
     if (!posed && !sure) continue;
     // Keypoints too unsure to outline the person: the detector's box does.
@@ -324,10 +363,12 @@ std::vector<MovenetPerson> TopDownDetector::detect(const ImageBuffer& frame) {
   carry(found);
   std::vector<Box2D> boxes;
   box_scores_.clear();
+  newcomer_.clear();
   for (std::size_t i = 0; i < followed_.size(); ++i) {
     if (carried_[i]) continue;
     boxes.push_back(moved(followed_[i].box, followed_[i].vx, followed_[i].vy));
     box_scores_.push_back(followed_[i].box_score);
+    newcomer_.push_back(0);
   }
   const bool run_detector =
       frame_ % options_.detect_every == 0 || lost_someone_ || followed_.empty();
@@ -380,6 +421,7 @@ std::vector<MovenetPerson> TopDownDetector::detect(const ImageBuffer& frame) {
       if (!known) {
         boxes.push_back(d.box);
         box_scores_.push_back(d.score);
+        newcomer_.push_back(1);
       }
     }
   }

@@ -49,7 +49,14 @@ struct TopDownOptions {
   bool detector_whole_frame = false;
   // A detector box overlapping a followed person's box by more than this is that person.
   float followed_overlap = 0.3f;
-  float crop_padding = 1.25f;       // crop side = longer box side × this
+  float crop_padding = 1.25f;  // crop side = longer box side × this
+  // A box shorter than small_box_height px (0: none) gets a crop of side longer box side ×
+  // small_crop_padding instead: more context around a small person, whose detector box is
+  // loose (upscaled to the model's input like every crop). 1.5 a priori: MediaPipe's
+  // detection-to-ROI square is 1.25 × the diameter of the body's enclosing circle around the
+  // hips, ~1.1-1.2 × a standing person's height, i.e. ~1.4-1.5 × the height.
+  float small_box_height = 0.0f;
+  float small_crop_padding = 1.5f;
   float min_keypoint_score = 0.3f;  // keypoints below are missing
   // A crop shows a person when at least min_keypoints keypoints pass and their mean score reaches
   // min_person_score.
@@ -69,11 +76,20 @@ struct TopDownOptions {
   // cut), kept to measure the two against each other. The crop's box is the latter either way
   // (posed_crop_box).
   bool anatomical_landmark_box = true;
+  // With the anatomical box: the head's margin is also at least kHeadAboveEyesPerEyeToShoulder ×
+  // the eyes-to-shoulders height, so that it does not shrink with the landmarks' extent when the
+  // legs are outside the picture (or hidden), which leaves eyes to hips.
+  bool head_margin_from_shoulders = false;
   // A person the detector is sure of: a box scoring at least this is a person even when its
   // crop's keypoints fail the test above (blurred or crowded people); only the keypoints scoring
   // min_keypoint_score are kept, and the box is the detector's. Such a person is followed until
   // the next detector run, which keeps them only if it still finds them this sure. 0: off.
   float sure_box_score = 0.0f;
+  // A newcomer (a detector box nobody followed) is a person only when their posed box overlaps
+  // the detector's box by at least this IoU (0: off): a pose whose box disagrees with the box it
+  // was cropped for is on a neighbour or a mix of people in a row. 0.5 a priori: the IoU at which
+  // the evaluation and the detector's NMS call two boxes one person.
+  float newcomer_agreement = 0.0f;
   float duplicate_overlap = 0.6f;  // people whose boxes overlap more are one
   // The network runtime of both networks and their threads (graph_runner.hpp: XNNPACK's are each
   // network's own, 0 meaning one; cv::dnn's are process-wide, 0 its default).
@@ -103,6 +119,10 @@ struct CropVerdict {
 };
 CropVerdict judge_crop(const SinglePose& pose, const TopDownOptions& options);
 
+// The square a box's crop is cut from: its longer side × crop_padding, or × small_crop_padding
+// for a box shorter than small_box_height.
+SquareRegion crop_region(const Box2D& box, const TopDownOptions& options);
+
 // The box of a posed person cut from `region` of a `frame_width` × `frame_height` picture, in
 // frame pixels. With BlazePose (and box_landmark_presence <= 1) that of the body landmarks whose
 // presence reaches box_landmark_presence, when at least two do, grown by kLandmarkBoxMargins (with
@@ -127,6 +147,11 @@ Box2D posed_crop_box(const SinglePose& pose, const SquareRegion& region,
 // biacromial breadth, British men), the shoulder landmark sitting about as far inside them:
 // 0.03 (50 mm of 1630). Chosen from these tables before any run, not fitted.
 inline constexpr BoxMargins kLandmarkBoxMargins{0.07f, 0.0f, 0.03f};
+
+// The top of the head above the eyes as a share of the eyes' height above the shoulders (the
+// acromion): 110 / (1630 - 1425) = 0.54 for British men, 105 / (1505 - 1310) = 0.54 for women
+// (50th percentiles, Pheasant's tables as above; shoulder height there). A priori, not fitted.
+inline constexpr float kHeadAboveEyesPerEyeToShoulder = 0.54f;
 
 // Where the time of detect() went, summed over the frames since the detector was made (seconds,
 // wall clock). CenterNet runs on a helper thread when there are several workers, then overlapping
@@ -202,8 +227,9 @@ class TopDownDetector {
   std::unique_ptr<OrderedWorkers<int>> helpers_;  // workers - 1 threads; none with one worker
   GraphTensor image_, crops_;  // the networks' inputs, reused from frame to frame
   std::vector<SquareRegion> regions_;
-  std::vector<Box2D> crop_boxes_;  // per crop of the frame: the box it was cut around
-  std::vector<float> box_scores_;  // per box of the frame: the detector's score of it
+  std::vector<Box2D> crop_boxes_;       // per crop of the frame: the box it was cut around
+  std::vector<float> box_scores_;       // per box of the frame: the detector's score of it
+  std::vector<std::uint8_t> newcomer_;  // per box of the frame: a detector box nobody followed
   std::vector<SinglePose> found_;
   std::vector<Followed> followed_;
   std::unique_ptr<KeypointFlow> flow_;  // with keypoint_every > 1

@@ -251,6 +251,54 @@ TEST(TopDownDetector, ABlazePoseBoxReachesTheFeetItsLandmarksPlace) {
   expect_box(posed_crop_box(movenet, region, o), keypoints_box);
 }
 
+// The head's margin from the eyes' height above the shoulders (head_margin_from_shoulders): the
+// same when the legs leave the picture, where 0.07 of the landmarks' extent shrinks with them.
+TEST(TopDownDetector, TheHeadMarginFromTheShouldersStaysWhenTheLegsLeave) {
+  constexpr int kSize = 256;
+  GraphTensor landmarks{{1, kBlazePoseLandmarks * 5}, {}}, flag{{1, 1, 1, 1}, {0.9f}};
+  landmarks.values.assign(landmarks.size(), 0.0f);
+  const auto set = [&](int k, float x, float y, float presence) {
+    float* l = landmarks.values.data() + k * 5;
+    l[0] = x, l[1] = y, l[3] = 3, l[4] = presence;  // logits
+  };
+  // Landmark k at y = 40 + 5 k (nose 40, eyes 2 and 5 at 50 and 65, shoulders 11 and 12 at 95
+  // and 100: the eyes 40 px above the shoulders), x = 128 but landmark 20 at x 20.
+  for (int k = 0; k < kBlazePoseBody; ++k) set(k, k == 20 ? 20 : 128, 40 + 5.0f * k, 3);
+  const SinglePose whole = decode_blazepose(landmarks, flag, kSize, 0);
+  for (int k = 23; k < kBlazePoseBody; ++k) set(k, 128, 40 + 5.0f * k, -3);  // legs outside
+  const SinglePose no_legs = decode_blazepose(landmarks, flag, kSize, 0);
+  const SquareRegion region{500, 300, kSize};  // crop pixel (x, y) is frame (372 + x, 172 + y)
+  TopDownOptions o;
+  // Without: the top 0.07 × the extent above the nose (frame y 212): 160 px whole (11.2), 110
+  // px without the legs (nose to landmark 22 at 322: 7.7).
+  EXPECT_NEAR(posed_box(whole, region, o, 1000, 1000).y, 200.8f, 1e-3);
+  EXPECT_NEAR(posed_box(no_legs, region, o, 1000, 1000).y, 204.3f, 1e-3);
+  // With: 0.54 × 40 = 21.6 px above the nose either way; the bottom does not move.
+  o.head_margin_from_shoulders = true;
+  const Box2D box = posed_box(whole, region, o, 1000, 1000);
+  EXPECT_NEAR(box.y, 190.4f, 1e-3);
+  EXPECT_NEAR(box.y + box.height, 372.0f, 1e-3);
+  EXPECT_NEAR(posed_box(no_legs, region, o, 1000, 1000).y, 190.4f, 1e-3);
+  // Eyes not present: the extent's margin again.
+  for (const int k : {2, 5}) set(k, 128, 40 + 5.0f * k, -3);
+  EXPECT_NEAR(posed_box(decode_blazepose(landmarks, flag, kSize, 0), region, o, 1000, 1000).y,
+              204.3f, 1e-3);
+}
+
+// Boxes shorter than small_box_height get crops of small_crop_padding, the others crop_padding.
+TEST(TopDownDetector, SmallBoxesGetCropsWithMoreContext) {
+  TopDownOptions o;
+  o.small_box_height = 100;
+  o.small_crop_padding = 1.5f;
+  const SquareRegion small = crop_region({10, 20, 30, 80}, o);
+  EXPECT_FLOAT_EQ(small.side, 120.0f);
+  EXPECT_FLOAT_EQ(small.cx, 25.0f);
+  EXPECT_FLOAT_EQ(small.cy, 60.0f);
+  EXPECT_FLOAT_EQ(crop_region({10, 20, 30, 100}, o).side, 125.0f);
+  o.small_box_height = 0;  // off
+  EXPECT_FLOAT_EQ(crop_region({10, 20, 30, 80}, o).side, 100.0f);
+}
+
 // BlazePose lite in the crops: the pedestrians of vtest frame 300, each with a presence flag of
 // at least MediaPipe's 0.5 as the person score, their keypoints confident ones only.
 TEST(TopDownDetector, BlazePoseFindsThePedestriansOfFrame300) {
@@ -287,6 +335,20 @@ TEST(TopDownDetector, BlazePoseFindsThePedestriansOfFrame300) {
       EXPECT_TRUE(same) << "Lightning's person at x " << r.box.x << " not found by BlazePose";
     }
   }
+}
+
+// newcomer_agreement: a newcomer is a person only when its posed box overlaps its detector box
+// by that IoU. At 0.99 no posed box agrees that closely, so the first frame of frame 300's
+// walkers (all newcomers; found with the option off in the tests above) finds nobody.
+TEST(TopDownDetector, NewcomersWhosePoseDisagreesWithTheirBoxAreNotPeople) {
+  std::string why;
+  const auto m = models(why);
+  if (!m) GTEST_SKIP() << why;
+  TopDownOptions o;
+  o.newcomer_agreement = 0.99f;
+  EXPECT_TRUE(TopDownDetector(o, m->lightning, m->centernet).detect(shifted_frame(0)).empty());
+  o.newcomer_agreement = 1.5f;
+  EXPECT_THROW(TopDownDetector(o, m->lightning, m->centernet), std::invalid_argument);
 }
 
 // Frames 0..5 of the moving picture with the keypoint network every frame, then every third.

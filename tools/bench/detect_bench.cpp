@@ -101,7 +101,7 @@ Strategy make_strategy(const std::string& spec, detect::Backend backend, int thr
     } catch (const std::invalid_argument&) {
       throw std::invalid_argument(
           "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:kEVERY][:uSURE][:"
-          "bPRESENCE][:m0] with "
+          "bPRESENCE][:m0][:h1][:cH[xP]][:aIOU] with "
           "MODEL " +
           std::string(detect::pose_model_names()) + ", got " + spec);
     }
@@ -109,7 +109,8 @@ Strategy make_strategy(const std::string& spec, detect::Backend backend, int thr
     // Then WORKERS and THREADS, and anywhere tN (person detector on N tiles; tNw: and the whole
     // frame), sX (its score threshold), kK (keypoint pass every K frames), uX (sure_box_score) and
     // bX (box_landmark_presence), m0 (the landmark box widened as the keypoints', not cut to the
-    // picture: anatomical_landmark_box off).
+    // picture: anatomical_landmark_box off), h1 (head_margin_from_shoulders), cH[xP] (boxes under
+    // H px cropped with padding P: small_box_height, small_crop_padding).
     std::vector<std::string> numbers;
     for (std::size_t i = 3; i < parts.size(); ++i) {
       if (parts[i].size() > 1 && parts[i][0] == 't') {
@@ -123,7 +124,16 @@ Strategy make_strategy(const std::string& spec, detect::Backend backend, int thr
         o.box_landmark_presence = std::stof(parts[i].substr(1));
       else if (parts[i] == "m0")
         o.anatomical_landmark_box = false;
-      else if (parts[i].size() > 1 && parts[i][0] == 'k')
+      else if (parts[i].size() > 1 && parts[i][0] == 'a')
+        o.newcomer_agreement = std::stof(parts[i].substr(1));
+      else if (parts[i] == "h1")
+        o.head_margin_from_shoulders = true;
+      else if (parts[i].size() > 1 && parts[i][0] == 'c') {
+        // cH or cHxP: boxes under H px get crops of padding P (default small_crop_padding).
+        const auto hp = split(parts[i].substr(1), 'x');
+        o.small_box_height = std::stof(hp.at(0));
+        if (hp.size() > 1) o.small_crop_padding = std::stof(hp[1]);
+      } else if (parts[i].size() > 1 && parts[i][0] == 'k')
         o.keypoint_every = std::stoi(parts[i].substr(1));
       else
         numbers.push_back(parts[i]);
@@ -131,7 +141,7 @@ Strategy make_strategy(const std::string& spec, detect::Backend backend, int thr
     if (numbers.size() > 2)
       throw std::invalid_argument(
           "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:kEVERY][:uSURE][:"
-          "bPRESENCE][:m0], got " +
+          "bPRESENCE][:m0][:h1][:cH[xP]][:aIOU], got " +
           spec);
     o.backend = backend;
     o.threads = numbers.size() == 2 ? std::stoi(numbers[1]) : threads;
@@ -146,7 +156,7 @@ Strategy make_strategy(const std::string& spec, detect::Backend backend, int thr
   throw std::invalid_argument("unknown strategy '" + spec +
                               "' (multipose:SIZE, tiles:CxR:TILE:FRAME, "
                               "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:"
-                              "kEVERY][:uSURE][:bPRESENCE][:m0])");
+                              "kEVERY][:uSURE][:bPRESENCE][:m0][:h1][:cH[xP]][:aIOU])");
 }
 
 // Every frame of a video, or the one image of a still.
@@ -322,10 +332,11 @@ json candidates(const std::string& input, const Run& reference, const std::vecto
 // Why each true person a top-down strategy missed was missed (--diagnose): its person detector
 // is run again on the annotated frames at the score floor `floor`, and each missed box is put in
 // one cause: (d) a person was found near it but their box matches at IoU < min_iou (nearest
-// IoU >= 0.3); (a) the detector proposed nothing near it (IoU >= 0.3) at any score >= floor; (b)
-// only below the strategy's threshold; (c) proposed above it, yet no person came out near it (the
-// keypoint stage rejected the crop, duplicate removal dropped it, or, between detector runs, no
-// crop was looked at there). Prints a Markdown table per strategy.
+// IoU >= 0.3 among the found boxes matched to no other true person: a neighbour's box is not
+// this person's loose box); (a) the detector proposed nothing near it (IoU >= 0.3) at any score >=
+// floor; (b) only below the strategy's threshold; (c) proposed above it, yet no person came out
+// near it (the keypoint stage rejected the crop, duplicate removal dropped it, or, between detector
+// runs, no crop was looked at there). Prints a Markdown table per strategy.
 void diagnose(const std::string& input, const eval::DetectionTruth& truth, const std::string& name,
               const Run& r, const detect::TopDownOptions& o, detect::Backend backend, int threads,
               float min_iou, float floor) {
@@ -342,6 +353,17 @@ void diagnose(const std::string& input, const eval::DetectionTruth& truth, const
   detect::ProposalOptions low = used;
   low.min_score = floor;
   std::map<std::string, int> causes;
+  // The same causes by true height (the brief's bands), with the found people as a first row.
+  const std::array<const char*, 4> bands{"< 60 px", "60-100 px", "100-200 px", ">= 200 px"};
+  std::map<std::string, std::array<int, 4>> by_cause;
+  std::array<int, 4> band_people{};
+  std::array<std::array<int, 4>, 3> false_finds{};  // loose, second box, nobody's; by height
+  std::array<int, 5> rejected_score{};  // (c1): the crop's score in [0, 0.1), ..., [0.4, 0.5]+
+  int band = 0;
+  const auto count = [&](const std::string& cause) {
+    causes[cause]++;
+    by_cause[cause][static_cast<std::size_t>(band)]++;
+  };
   std::map<std::string, std::pair<int, int>> by_height;  // found, all
   std::array<int, 3> nearest{};                          // misses by nearest IoU bucket
   std::array<int, 3> loose{};  // (d) by the nearest box's height: < 0.9, 0.9-1.1, > 1.1 x true
@@ -363,24 +385,47 @@ void diagnose(const std::string& input, const eval::DetectionTruth& truth, const
     for (const auto& d : proposed)
       if (d.score >= used.min_score) kept.push_back(d.box);
     const auto alone = eval::score_frame(*t, kept, min_iou);
+    // Each false find: a loose box of a person nobody matched, a second box on a matched person,
+    // or nobody's (no true box within IoU 0.3), by its own height.
+    for (std::size_t d = 0; d < found.size(); ++d) {
+      if (score.match[d] != -1) continue;
+      float near = 0;
+      int nearest_truth = -1;
+      for (std::size_t k = 0; k < t->people.size(); ++k)
+        if (const float v = detect::iou(found[d], t->people[k]); v > near)
+          near = v, nearest_truth = static_cast<int>(k);
+      const bool taken =
+          std::find(score.match.begin(), score.match.end(), nearest_truth) != score.match.end();
+      const int kind = near < 0.3f ? 2 : taken ? 1 : 0;
+      const float h = found[d].height;
+      false_finds[static_cast<std::size_t>(kind)][h < 60 ? 0 : h < 100 ? 1 : h < 200 ? 2 : 3]++;
+    }
     alone_truths += alone.truths, alone_counted += alone.detections, alone_matched += alone.matched;
     for (std::size_t k = 0; k < t->people.size(); ++k) {
       const Box2D& box = t->people[k];
       ++truths;
       const bool hit = std::find(score.match.begin(), score.match.end(), static_cast<int>(k)) !=
                        score.match.end();
-      const std::string band = box.height < 100   ? "< 100 px"
-                               : box.height < 150 ? "100-150 px"
-                               : box.height < 250 ? "150-250 px"
-                                                  : ">= 250 px";
-      by_height[band].second++;
+      const std::string band_name = box.height < 100   ? "< 100 px"
+                                    : box.height < 150 ? "100-150 px"
+                                    : box.height < 250 ? "150-250 px"
+                                                       : ">= 250 px";
+      by_height[band_name].second++;
+      band = box.height < 60 ? 0 : box.height < 100 ? 1 : box.height < 200 ? 2 : 3;
+      band_people[static_cast<std::size_t>(band)]++;
       if (hit) {
-        by_height[band].first++;
+        by_height[band_name].first++;
+        by_cause["found"][static_cast<std::size_t>(band)]++;
         continue;
       }
-      float near = 0, near_height = 0;
-      for (const Box2D& b : found)
-        if (const float v = detect::iou(b, box); v > near) near = v, near_height = b.height;
+      // The nearest found box, and the nearest of those matched to no other true person: a
+      // neighbour's box overlapping this one by 0.3-0.5 is not a loose box of this person.
+      float near = 0, free_near = 0, near_height = 0;
+      for (std::size_t j = 0; j < found.size(); ++j) {
+        const float v = detect::iou(found[j], box);
+        near = std::max(near, v);
+        if (score.match[j] < 0 && v > free_near) free_near = v, near_height = found[j].height;
+      }
       nearest[near < 0.1f ? 0 : near < 0.3f ? 1 : 2]++;
       float best_score = -1, best_iou = 0.3f;    // the best proposal near the box
       const detect::Detection* above = nullptr;  // the nearest passing the threshold
@@ -390,17 +435,17 @@ void diagnose(const std::string& input, const eval::DetectionTruth& truth, const
         best_score = std::max(best_score, d.score);
         if (d.score >= used.min_score && v >= best_iou) above = &d, best_iou = v;
       }
-      if (near >= 0.3f) {
-        causes["(d) found, box IoU 0.3-0.5"]++;
+      if (free_near >= 0.3f) {
+        count("(d) found, box IoU 0.3-0.5");
         const float ratio = near_height / box.height;
         loose[ratio < 0.9f ? 0 : ratio <= 1.1f ? 1 : 2]++;
       } else if (best_score < 0) {
-        causes["(a) no proposal near it"]++;
+        count("(a) no proposal near it");
       } else if (!above) {
-        causes["(b) proposal below threshold"]++;
+        count("(b) proposal below threshold");
       } else {
         // The keypoint stage on that proposal's crop, as the strategy runs it.
-        const detect::SquareRegion region = detect::square_around(above->box, o.crop_padding);
+        const detect::SquareRegion region = detect::crop_region(above->box, o);
         detect::image_batch(crop, 1, pose.input_size(), pose.input_size());
         detect::fill_region(*f, region, crop, 0);
         const detect::SinglePose answer = pose.run(crop).front();
@@ -413,15 +458,24 @@ void diagnose(const std::string& input, const eval::DetectionTruth& truth, const
         }
         // A sure box is a person whatever its keypoints (TopDownOptions::sure_box_score).
         const bool sure = o.sure_box_score > 0 && above->score >= o.sure_box_score;
-        const bool posed = detect::judge_crop(answer, o).posed;
-        if (!posed && !sure)
-          causes["(c1) proposed, crop's keypoints rejected"]++;
-        else if (!posed)
-          causes["(c3) proposed, person dropped (duplicate) or not looked for"]++;
-        else if (detect::iou(detect::keypoint_box(points, 0.12f), box) < 0.3f)
-          causes["(c2) proposed, crop's keypoints on someone else"]++;
-        else
-          causes["(c3) proposed, person dropped (duplicate) or not looked for"]++;
+        const detect::CropVerdict verdict = detect::judge_crop(answer, o);
+        // A newcomer whose posed box disagrees with its proposal is rejected too (agreement).
+        const bool agrees =
+            o.newcomer_agreement <= 0 ||
+            detect::iou(detect::posed_box(answer, region, o, f->width(), f->height()),
+                        above->box) >= o.newcomer_agreement;
+        const bool posed = verdict.posed && agrees;
+        if (!posed && !sure) {
+          count("(c1) proposed, crop's keypoints rejected");
+          rejected_score[static_cast<std::size_t>(
+              std::clamp(static_cast<int>(verdict.score * 10), 0, 4))]++;
+        } else if (!posed) {
+          count("(c3) proposed, person dropped (duplicate) or not looked for");
+        } else if (detect::iou(detect::keypoint_box(points, 0.12f), box) < 0.3f) {
+          count("(c2) proposed, crop's keypoints on someone else");
+        } else {
+          count("(c3) proposed, person dropped (duplicate) or not looked for");
+        }
       }
     }
   }
@@ -438,8 +492,28 @@ void diagnose(const std::string& input, const eval::DetectionTruth& truth, const
       "0.3-0.5: %d (its box's height < 0.9 x the true one: %d, 0.9-1.1: %d, > 1.1: %d)\n\n"
       "| true height | recall |\n|---|---|\n",
       nearest[0], nearest[1], nearest[2], loose[0], loose[1], loose[2]);
-  for (const auto& [band, n] : by_height)
-    std::printf("| %s | %d / %d |\n", band.c_str(), n.first, n.second);
+  for (const auto& [band_name, n] : by_height)
+    std::printf("| %s | %d / %d |\n", band_name.c_str(), n.first, n.second);
+  std::printf("\n| cause, by true height | %s | %s | %s | %s |\n|---|---|---|---|---|\n", bands[0],
+              bands[1], bands[2], bands[3]);
+  for (const auto& [cause, n] : by_cause)
+    std::printf("| %s | %d | %d | %d | %d |\n", cause.c_str(), n[0], n[1], n[2], n[3]);
+  std::printf("| true people | %d | %d | %d | %d |\n", band_people[0], band_people[1],
+              band_people[2], band_people[3]);
+  const std::array<const char*, 3> false_kinds{
+      "false find: loose box (IoU 0.3-0.5) of an unmatched person",
+      "false find: second box on a matched person (IoU >= 0.3)",
+      "false find: nobody's (no true box at IoU >= 0.3)"};
+  std::printf("\n| false finds, by their own height | %s | %s | %s | %s |\n|---|---|---|---|---|\n",
+              bands[0], bands[1], bands[2], bands[3]);
+  for (std::size_t k = 0; k < false_kinds.size(); ++k)
+    std::printf("| %s | %d | %d | %d | %d |\n", false_kinds[k], false_finds[k][0],
+                false_finds[k][1], false_finds[k][2], false_finds[k][3]);
+  std::printf(
+      "\n(c1) by the rejected crop's score (BlazePose: its pose flag; MoveNet: the passing "
+      "keypoints' mean): [0, 0.1) %d, [0.1, 0.2) %d, [0.2, 0.3) %d, [0.3, 0.4) %d, >= 0.4 %d\n",
+      rejected_score[0], rejected_score[1], rejected_score[2], rejected_score[3],
+      rejected_score[4]);
   std::fflush(stdout);
 }
 
@@ -484,24 +558,28 @@ int main(int argc, char** argv) {
               "../shared/data/eval/openpose_examples_media/COCO_val2014_000000000241.jpg,"
               "../shared/data/eval/openpose_examples_media/COCO_val2014_000000000328.jpg,"
               "../shared/data/eval/openpose_examples_media/COCO_val2014_000000000536.jpg")
-      .option("strategies", "LIST",
-              "the first (on the first runtime) is the reference for keypoint distances: "
-              "multipose:SIZE, "
-              "tiles:CxR:TILE:FRAME, "
-              "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:kEVERY][:"
-              "uSURE][:bPRESENCE][:m0] "
-              "(MODEL: lightning, thunder, blazepose-lite, blazepose-full, blazepose-heavy; "
-              "workers: copies of the keypoint network sharing a frame's crops; tTILES: person "
-              "detector tiles, tTILESw: and the whole frame, sSCORE: its box score floor, uSURE: "
-              "boxes scoring SURE are people whatever their keypoints, bPRESENCE: BlazePose "
-              "boxes from the landmarks of this presence (default 0.5; above 1: from the kept "
-              "keypoints), m0: that landmark box widened as the keypoints' and not cut to the "
-              "picture (before the anatomical margins), kEVERY: keypoint pass every "
-              "EVERY "
-              "frames, optical flow between; a top-down "
-              "strategy also prints where its time went)",
-              "topdown:thunder:1,multipose:256,multipose:512,tiles:2x2:256:256,"
-              "topdown:lightning:1,topdown:lightning:10,topdown:thunder:10")
+      .option(
+          "strategies", "LIST",
+          "the first (on the first runtime) is the reference for keypoint distances: "
+          "multipose:SIZE, "
+          "tiles:CxR:TILE:FRAME, "
+          "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:kEVERY][:"
+          "uSURE][:bPRESENCE][:m0][:h1][:cH[xP]][:aIOU] "
+          "(MODEL: lightning, thunder, blazepose-lite, blazepose-full, blazepose-heavy; "
+          "workers: copies of the keypoint network sharing a frame's crops; tTILES: person "
+          "detector tiles, tTILESw: and the whole frame, sSCORE: its box score floor, uSURE: "
+          "boxes scoring SURE are people whatever their keypoints, bPRESENCE: BlazePose "
+          "boxes from the landmarks of this presence (default 0.5; above 1: from the kept "
+          "keypoints), m0: that landmark box widened as the keypoints' and not cut to the "
+          "picture (before the anatomical margins), h1: BlazePose's head margin at least 0.54 x "
+          "the eyes' height above the shoulders, cH[xP]: boxes under H px get crops of "
+          "padding P (default 1.5), aIOU: a newcomer is a person only when its posed box overlaps "
+          "the detector's by this IoU, kEVERY: keypoint pass every "
+          "EVERY "
+          "frames, optical flow between; a top-down "
+          "strategy also prints where its time went)",
+          "topdown:thunder:1,multipose:256,multipose:512,tiles:2x2:256:256,"
+          "topdown:lightning:1,topdown:lightning:10,topdown:thunder:10")
       .option("truth", "DIR", "hand-checked boxes", "tests/data/detection")
       .option("iou", "X", "a detection matches a true box at this IoU", "0.5")
       .option("backends", "LIST",
@@ -609,6 +687,17 @@ int main(int argc, char** argv) {
                         {"frames_per_second", fps},
                         {"frames", runs[s].frames},
                         {"seconds", runs[s].seconds}});
+      }
+      // No cap on people (issue 18): how many frames show more than MultiPose's 6.
+      for (std::size_t s = 0; s < runs.size(); ++s) {
+        int crowded = 0;
+        std::size_t most = 0;
+        for (const auto& [frame, found] : runs[s].people) {
+          crowded += found.size() > 6 ? 1 : 0;
+          most = std::max(most, found.size());
+        }
+        std::printf("%s%s: %d of %d frames with more than 6 people found (at most %zu)\n",
+                    s == 0 ? "\n" : "", names[s].c_str(), crowded, runs[s].frames, most);
       }
       print_profiles(names, runs);
       std::fflush(stdout);
