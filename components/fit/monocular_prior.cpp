@@ -100,6 +100,7 @@ bool MonocularPrior::add(MultiViewFrameInput& frame,
       root_confidence > 0.0f ? glm::vec2(best->keypoints[3 * kRoot], best->keypoints[3 * kRoot + 1])
                              : glm::vec2(nan, nan);
   recon::turn_onto_ray(pose, cam, root_pixel);
+  frame.prior.robust_rad = static_cast<float>(std::max(0.0, options_.robust_rad));
   const glm::dmat3 camera_to_world = glm::transpose(cam.rotation);
   for (int b = 0; b < kBodyJoints - 1; ++b) {
     const int parent = kJointParent[static_cast<std::size_t>(b)];
@@ -111,11 +112,41 @@ bool MonocularPrior::add(MultiViewFrameInput& frame,
     const double weight = bone_weight(body[static_cast<std::size_t>(parent)],
                                       body[static_cast<std::size_t>(b)], cameras);
     frame.prior.inv_sigma[static_cast<std::size_t>(b)] = static_cast<float>(weight);
-    frame.prior.reference[static_cast<std::size_t>(b)] = options_.few_views_reference &&
-                                                         options_.few_views_rad > 0.0 &&
-                                                         weight >= 1.0 / options_.few_views_rad;
+    const bool few = options_.few_views_rad > 0.0 && weight >= 1.0 / options_.few_views_rad;
+    frame.prior.few[static_cast<std::size_t>(b)] = few;
+    frame.prior.reference[static_cast<std::size_t>(b)] = options_.few_views_reference && few;
   }
   return frame.prior.any();
+}
+
+void MonocularPrior::settle_runs(std::span<MultiViewFrameInput> track, bool past_only) const {
+  const std::size_t min_run = static_cast<std::size_t>(std::max(1, options_.few_views_frames));
+  if (min_run <= 1) return;
+  const float weak =
+      options_.two_views_rad > 0.0 ? static_cast<float>(1.0 / options_.two_views_rad) : 0.0f;
+  const auto lacking = [](const DirectionPrior& p, int b) {
+    return !p.any() || p.few[static_cast<std::size_t>(b)];
+  };
+  for (int b = 0; b < kBodyJoints - 1; ++b) {
+    const auto bone = static_cast<std::size_t>(b);
+    for (std::size_t start = 0; start < track.size();) {
+      if (!lacking(track[start].prior, b)) {
+        ++start;
+        continue;
+      }
+      std::size_t end = start;  // the run is [start, end)
+      while (end < track.size() && lacking(track[end].prior, b)) ++end;
+      for (std::size_t f = start; f < end; ++f) {
+        DirectionPrior& p = track[f].prior;
+        const std::size_t run = past_only ? f + 1 - start : end - start;
+        if (!p.few[bone] || run >= min_run) continue;
+        p.few[bone] = false;
+        p.inv_sigma[bone] = weak;
+        p.reference[bone] = false;
+      }
+      start = end;
+    }
+  }
 }
 
 }  // namespace mocap::fit

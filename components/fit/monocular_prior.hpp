@@ -35,6 +35,16 @@ struct MonocularPriorOptions {
   // nearly parallel, do not see depth along their axis: the noise is magnified). Exact
   // keypoints are trusted at any angle.
   double max_depth_error_m = 0.1;
+  // The strong weight needs a run of frames: a bone is weighted few_views_rad only where its
+  // ends lacked two good views for at least this many consecutive frames of the track (full
+  // mode: the whole run, both sides of the frame; live: the run up to the frame). A shorter run
+  // (a joint dropped in a frame or two, which the neighbouring frames and the other views fill)
+  // takes two_views_rad. 1: per frame. Chosen on HumanEva-I Train and the virtual scenes of CMU
+  // train clips (docs/multiview.md "The monocular prior").
+  int few_views_frames = 8;
+  // A Cauchy loss on each bone's term, its scale in radians of chord (set in DirectionPrior):
+  // beyond it a retrieval facing or bending the wrong way pulls less and less. <= 0: squared.
+  double robust_rad = 0.3;
   // Bones of the first kind also start from the retrieved direction instead of the triangulated
   // one (worse on HumanEva Train: off).
   bool few_views_reference = false;
@@ -60,6 +70,12 @@ class MonocularPrior {
                      std::span<const camera::Camera> cameras) const;
 
   const MonocularPriorOptions& options() const { return options_; }
+
+  // The run rule over one track's consecutive frames (after add() on each; a frame without a
+  // prior, e.g. the person unseen, counts as lacking views): a bone marked few keeps the strong
+  // weight only within a run of at least few_views_frames frames, else it takes the two-views
+  // weight. past_only (live): a run counts only its frames up to the frame weighed.
+  void settle_runs(std::span<MultiViewFrameInput> track, bool past_only) const;
 
  private:
   const posedb::Database& db_;

@@ -34,7 +34,13 @@ struct Clip {
   std::vector<Body> truth;                          // HumanEva's world
 };
 
-Clip reconstruct(const posedb::Database& db) {
+// A joint hidden from C2 in one frame only (besides kHidden in every frame).
+struct OneFrameDrop {
+  int joint = -1;
+  std::size_t frame = 0;
+};
+
+Clip reconstruct(const posedb::Database& db, OneFrameDrop drop = {}) {
   const auto folder = test::shared_data() / "eval/humaneva_i_videopose3d";
   const auto cameras = he::load_cameras(folder / he::kCamerasFile);
   const auto sequences =
@@ -61,6 +67,7 @@ Clip reconstruct(const posedb::Database& db) {
       const std::span<float> xyc = obs.add_person(v);
       for (int j = 0; j < kBodyJoints; ++j) {
         if (v == 1 && (j == kHidden[0] || j == kHidden[1])) continue;  // C2 does not see them
+        if (v == 1 && j == drop.joint && f == drop.frame) continue;
         const glm::dvec2 p =
             c.rig[static_cast<std::size_t>(v)].undistort_pixel({in[3 * j], in[3 * j + 1]});
         xyc[3 * j] = static_cast<float>(p.x);
@@ -148,6 +155,43 @@ TEST(MonocularPrior, GivesDepthToAJointSeenByOneCamera) {
   EXPECT_LT(prior_mm, 0.4 * without_mm);
   // The prior decides: turned to the other depth, the arm follows it (the test can fail).
   EXPECT_GT(flipped_mm, prior_mm + 100.0);
+}
+
+TEST(MonocularPrior, IsStrongOnlyWhereViewsLackForARunOfFrames) {
+  MOCAP_REQUIRE_SHARED("eval/humaneva_i_videopose3d/humaneva_cameras.json");
+  MOCAP_REQUIRE_SMALL_DATABASE(path);
+  const posedb::Database db = posedb::Database::open(path);
+  constexpr int kDropped = index(Joint::left_wrist);  // the left forearm's end
+  constexpr std::size_t kDropFrame = 12;
+  const Clip c = reconstruct(db, {kDropped, kDropFrame});
+  ASSERT_FALSE(c.results[kDropFrame].people.empty());
+  ASSERT_LT(c.results[kDropFrame].body_of(0)[kDropped].view_count(), 2);
+  MonocularPrior prior(db);
+  const auto& o = prior.options();
+  ASSERT_GT(o.few_views_frames, 1);
+  ASSERT_LT(static_cast<std::size_t>(o.few_views_frames), kFrames);
+  const float strong = static_cast<float>(1.0 / o.few_views_rad);
+  const float weak = static_cast<float>(1.0 / o.two_views_rad);
+  constexpr int kForearm = kHidden[1];  // the right wrist's bone: C1 only, in every frame
+  for (const bool live : {false, true}) {
+    int with_prior = 0;
+    std::vector<MultiViewFrameInput> track = inputs(c, &prior, false, &with_prior);
+    ASSERT_GE(with_prior, 20);  // all but the frames before the track is confirmed
+    // Per frame, both lack two views where they are hidden.
+    EXPECT_FLOAT_EQ(track[kDropFrame].prior.inv_sigma[kDropped], strong);
+    EXPECT_FLOAT_EQ(track[kDropFrame + 1].prior.inv_sigma[kDropped], weak);
+    prior.settle_runs(track, live);
+    // One dropped frame: the neighbouring frames and C1 fix it; the weak weight.
+    EXPECT_FLOAT_EQ(track[kDropFrame].prior.inv_sigma[kDropped], weak) << "live " << live;
+    EXPECT_FALSE(track[kDropFrame].prior.few[kDropped]);
+    // Hidden from C2 for the whole second: strong, in live mode once the run is long enough.
+    for (std::size_t f = 0; f < kFrames; ++f) {
+      if (!track[f].prior.any()) continue;  // not tracked yet: counts as lacking views
+      const bool strong_here = !live || f + 1 >= static_cast<std::size_t>(o.few_views_frames);
+      EXPECT_FLOAT_EQ(track[f].prior.inv_sigma[kForearm], strong_here ? strong : weak)
+          << "frame " << f << ", live " << live;
+    }
+  }
 }
 
 TEST(MonocularPrior, WeighsABoneByHowWellTheViewsFixItsEnds) {
