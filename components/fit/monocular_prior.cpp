@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <bit>
+#include <climits>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 
 #include <glm/geometric.hpp>
@@ -119,14 +121,24 @@ bool MonocularPrior::add(MultiViewFrameInput& frame,
   return frame.prior.any();
 }
 
+namespace {
+
+// Bone b lacked two good views at this frame: marked few, or no retrieval at all.
+bool lacking(const DirectionPrior& p, int b) {
+  const auto bone = static_cast<std::size_t>(b);
+  return p.few[bone] || !(glm::length(p.direction[bone]) > 0.0f);
+}
+
+}  // namespace
+
+float MonocularPrior::run_weight(std::size_t run) const {
+  const double sigma = run >= static_cast<std::size_t>(std::max(1, options_.few_views_frames))
+                           ? options_.few_views_rad
+                           : options_.two_views_rad;
+  return sigma > 0.0 ? static_cast<float>(1.0 / sigma) : 0.0f;
+}
+
 void MonocularPrior::settle_runs(std::span<MultiViewFrameInput> track, bool past_only) const {
-  const std::size_t min_run = static_cast<std::size_t>(std::max(1, options_.few_views_frames));
-  if (min_run <= 1) return;
-  const float weak =
-      options_.two_views_rad > 0.0 ? static_cast<float>(1.0 / options_.two_views_rad) : 0.0f;
-  const auto lacking = [](const DirectionPrior& p, int b) {
-    return !p.any() || p.few[static_cast<std::size_t>(b)];
-  };
   for (int b = 0; b < kBodyJoints - 1; ++b) {
     const auto bone = static_cast<std::size_t>(b);
     for (std::size_t start = 0; start < track.size();) {
@@ -138,14 +150,24 @@ void MonocularPrior::settle_runs(std::span<MultiViewFrameInput> track, bool past
       while (end < track.size() && lacking(track[end].prior, b)) ++end;
       for (std::size_t f = start; f < end; ++f) {
         DirectionPrior& p = track[f].prior;
-        const std::size_t run = past_only ? f + 1 - start : end - start;
-        if (!p.few[bone] || run >= min_run) continue;
-        p.few[bone] = false;
-        p.inv_sigma[bone] = weak;
-        p.reference[bone] = false;
+        if (!p.few[bone]) continue;
+        p.inv_sigma[bone] = run_weight(past_only ? f + 1 - start : end - start);
+        p.reference[bone] = options_.few_views_reference && p.inv_sigma[bone] > 0.0f &&
+                            p.inv_sigma[bone] == run_weight(SIZE_MAX);
       }
       start = end;
     }
+  }
+}
+
+void MonocularPrior::settle_newest(DirectionPrior* prior, Runs& run) const {
+  for (int b = 0; b < kBodyJoints - 1; ++b) {
+    const auto bone = static_cast<std::size_t>(b);
+    run[bone] = !prior || lacking(*prior, b) ? std::min(run[bone], INT_MAX - 1) + 1 : 0;
+    if (!prior || !prior->few[bone]) continue;
+    prior->inv_sigma[bone] = run_weight(static_cast<std::size_t>(run[bone]));
+    prior->reference[bone] = options_.few_views_reference && prior->inv_sigma[bone] > 0.0f &&
+                             prior->inv_sigma[bone] == run_weight(SIZE_MAX);
   }
 }
 

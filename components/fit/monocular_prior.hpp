@@ -11,6 +11,7 @@
 // other do not see depth along their common axis); weak where two views fix it; weakest where
 // three or more views agree. docs/multiview.md "The monocular prior".
 
+#include <array>
 #include <span>
 #include <vector>
 
@@ -72,12 +73,22 @@ class MonocularPrior {
   const MonocularPriorOptions& options() const { return options_; }
 
   // The run rule over one track's consecutive frames (after add() on each; a frame without a
-  // prior, e.g. the person unseen, counts as lacking views): a bone marked few keeps the strong
-  // weight only within a run of at least few_views_frames frames, else it takes the two-views
-  // weight. past_only (live): a run counts only its frames up to the frame weighed.
+  // prior, e.g. the person unseen, counts as lacking views): a bone marked few
+  // (DirectionPrior::few, left as it is) keeps the strong weight only within a run of at least
+  // few_views_frames frames, else it takes the two-views weight. past_only (live): a run counts
+  // only its frames up to the frame weighed. Settling again (e.g. a longer span of the same track)
+  // gives the same weights.
   void settle_runs(std::span<MultiViewFrameInput> track, bool past_only) const;
 
+  // The same, past only, one frame at a time (a stream): `run` holds each bone's frames lacking
+  // views up to the frame before (zeros for a new track); `prior` is the newest frame's, or none
+  // when the person was not seen.
+  using Runs = std::array<int, kBodyJoints - 1>;
+  void settle_newest(DirectionPrior* prior, Runs& run) const;
+
  private:
+  float run_weight(std::size_t run) const;  // inverse sigma of a few bone in a run this long
+
   const posedb::Database& db_;
   MonocularPriorOptions options_;
   recon::Matcher matcher_;

@@ -180,10 +180,24 @@ TEST(MonocularPrior, IsStrongOnlyWhereViewsLackForARunOfFrames) {
     // Per frame, both lack two views where they are hidden.
     EXPECT_FLOAT_EQ(track[kDropFrame].prior.inv_sigma[kDropped], strong);
     EXPECT_FLOAT_EQ(track[kDropFrame + 1].prior.inv_sigma[kDropped], weak);
+    // A stream settles frame by frame, the past only: the same weights as live's.
+    std::vector<MultiViewFrameInput> stream = track;
+    MonocularPrior::Runs runs{};
+    for (auto& frame : stream)
+      prior.settle_newest(frame.prior.any() ? &frame.prior : nullptr, runs);
     prior.settle_runs(track, live);
     // One dropped frame: the neighbouring frames and C1 fix it; the weak weight.
     EXPECT_FLOAT_EQ(track[kDropFrame].prior.inv_sigma[kDropped], weak) << "live " << live;
-    EXPECT_FALSE(track[kDropFrame].prior.few[kDropped]);
+    EXPECT_TRUE(track[kDropFrame].prior.few[kDropped]);  // the frame's own class is kept
+    if (live) {
+      for (std::size_t f = 0; f < kFrames; ++f)
+        EXPECT_EQ(stream[f].prior.inv_sigma, track[f].prior.inv_sigma) << "frame " << f;
+    }
+    // Settling again gives the same weights.
+    std::vector<MultiViewFrameInput> again = track;
+    prior.settle_runs(again, live);
+    for (std::size_t f = 0; f < kFrames; ++f)
+      EXPECT_EQ(again[f].prior.inv_sigma, track[f].prior.inv_sigma);
     // Hidden from C2 for the whole second: strong, in live mode once the run is long enough.
     for (std::size_t f = 0; f < kFrames; ++f) {
       if (!track[f].prior.any()) continue;  // not tracked yet: counts as lacking views
