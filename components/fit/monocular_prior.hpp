@@ -45,7 +45,7 @@ struct MonocularPriorOptions {
   int few_views_frames = 8;
   // A Cauchy loss on each bone's term, its scale in radians of chord (set in DirectionPrior):
   // beyond it a retrieval facing or bending the wrong way pulls less and less. <= 0: squared.
-  double robust_rad = 0.3;
+  double robust_rad = 1.0;
   // Bones of the first kind also start from the retrieved direction instead of the triangulated
   // one (worse on HumanEva Train: off).
   bool few_views_reference = false;
