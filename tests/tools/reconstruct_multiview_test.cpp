@@ -24,6 +24,7 @@
 #include "support/files.hpp"
 #include "support/mocap_process.hpp"
 #include "support/shared_data.hpp"
+#include "support/small_pose_database.hpp"
 
 namespace mocap::test {
 namespace {
@@ -251,6 +252,31 @@ TEST_F(ReconstructMultiView, ARigThatDisagreesWithTheViewsIsRefusedNamingTheCame
   write_file(garbage, "[cam_01]\nname = \x01\x02 [[[");
   EXPECT_NE(run("garbage", args("garbage", views_, garbage), err), 0);
   EXPECT_NE(err.find(garbage), std::string::npos) << err;
+}
+
+TEST_F(ReconstructMultiView, ADatabaseAddsTheMonocularPriorAndIsCheckedFirst) {
+  MOCAP_REQUIRE_SMALL_DATABASE(db);
+  std::string err;
+  // The prior is part of the fit: refused with --fit off, and an unreadable database is refused
+  // naming it, before the output folder is made.
+  auto off = args("off", views_);
+  off.insert(off.end(), {"--db", db});
+  EXPECT_NE(run("off", off, err), 0);
+  EXPECT_NE(err.find("--db"), std::string::npos) << err;
+  const std::string missing = dir_.file("missing.mdb");
+  auto bad = args("bad", views_, "", "live");
+  bad.insert(bad.end(), {"--db", missing});
+  EXPECT_NE(run("bad", bad, err), 0);
+  EXPECT_NE(err.find(missing), std::string::npos) << err;
+  EXPECT_FALSE(fs::exists(dir_.file("bad")));
+  // Given one, the live fit takes the prior (summary.json names the database) and writes every
+  // frame.
+  auto with = args("with", views_, "", "live");
+  with.insert(with.end(), {"--db", db});
+  ASSERT_EQ(run("with", with, err), 0) << err;
+  EXPECT_EQ(lines("with").size(), static_cast<std::size_t>(kFrames));
+  const json summary = json::parse(read_file(dir_.file("with") + "/summary.json"));
+  EXPECT_EQ(summary.value("prior_db", std::string()), db);
 }
 
 TEST_F(ReconstructMultiView, BadFramesAndAShorterViewLeaveTheOthersGoingOn) {

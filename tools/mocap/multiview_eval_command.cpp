@@ -107,7 +107,7 @@ int multiview_eval_command(int argc, char** argv) {
             "ours per frame, ours + tracking,\n+ skeleton fit on all views (full and live). "
             "Default: three sweeps around\n4 views, 3 people, σ 2 % (under a minute); "
             "--full: every combination.");
-  args.option("mocap", "DIR", "cmu31 folder with splits.txt (its heldout clips are used)",
+  args.option("mocap", "DIR", "cmu31 folder with splits.txt (the clips of --split are used)",
               "../shared/data/mocap/cmu31")
       .option("split", "NAME",
               "heldout (the evaluation) or train (for choosing settings: the train clips of the "
