@@ -211,7 +211,8 @@ std::vector<MultiviewResult> run_multiview_case(const std::vector<TruthSequence>
       std::vector<multiview::FrameResult> results = tracked;
       const double start = thread_cpu_s();
       std::optional<fit::MonocularPrior> prior;
-      if (method == MultiviewMethod::skeleton_fit_prior) prior.emplace(*options.prior_db);
+      if (method == MultiviewMethod::skeleton_fit_prior)
+        prior.emplace(*options.prior_db, options.prior);
       fit::fit_tracks(std::span(input).first(results.size()), results, fit_options,
                       method == MultiviewMethod::skeleton_fit_live,
                       multiview::KeypointSet::body15(), prior ? &*prior : nullptr);

@@ -22,6 +22,7 @@
 
 #include "eval/multiview_scene.hpp"
 #include "eval/virtual_protocol.hpp"
+#include "fit/monocular_prior.hpp"
 #include "posedb/database.hpp"
 
 namespace mocap::eval {
@@ -57,6 +58,7 @@ struct MultiviewProtocolOptions {
   // A pose database (the CMU train split): adds (iv) + skeleton fit + monocular prior, full mode,
   // the prior retrieved from it with fit::MonocularPrior's defaults.
   const posedb::Database* prior_db = nullptr;
+  fit::MonocularPriorOptions prior;  // its settings (defaults: as chosen on train data)
 };
 
 struct MultiviewResult {

@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <bit>
+#include <climits>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 
 #include <glm/geometric.hpp>
@@ -100,6 +102,7 @@ bool MonocularPrior::add(MultiViewFrameInput& frame,
       root_confidence > 0.0f ? glm::vec2(best->keypoints[3 * kRoot], best->keypoints[3 * kRoot + 1])
                              : glm::vec2(nan, nan);
   recon::turn_onto_ray(pose, cam, root_pixel);
+  frame.prior.robust_rad = static_cast<float>(std::max(0.0, options_.robust_rad));
   const glm::dmat3 camera_to_world = glm::transpose(cam.rotation);
   for (int b = 0; b < kBodyJoints - 1; ++b) {
     const int parent = kJointParent[static_cast<std::size_t>(b)];
@@ -111,11 +114,61 @@ bool MonocularPrior::add(MultiViewFrameInput& frame,
     const double weight = bone_weight(body[static_cast<std::size_t>(parent)],
                                       body[static_cast<std::size_t>(b)], cameras);
     frame.prior.inv_sigma[static_cast<std::size_t>(b)] = static_cast<float>(weight);
-    frame.prior.reference[static_cast<std::size_t>(b)] = options_.few_views_reference &&
-                                                         options_.few_views_rad > 0.0 &&
-                                                         weight >= 1.0 / options_.few_views_rad;
+    const bool few = options_.few_views_rad > 0.0 && weight >= 1.0 / options_.few_views_rad;
+    frame.prior.few[static_cast<std::size_t>(b)] = few;
+    frame.prior.reference[static_cast<std::size_t>(b)] = options_.few_views_reference && few;
   }
   return frame.prior.any();
+}
+
+namespace {
+
+// Bone b lacked two good views at this frame: marked few, or no retrieval at all.
+bool lacking(const DirectionPrior& p, int b) {
+  const auto bone = static_cast<std::size_t>(b);
+  return p.few[bone] || !(glm::length(p.direction[bone]) > 0.0f);
+}
+
+}  // namespace
+
+float MonocularPrior::run_weight(std::size_t run) const {
+  const double sigma = run >= static_cast<std::size_t>(std::max(1, options_.few_views_frames))
+                           ? options_.few_views_rad
+                           : options_.two_views_rad;
+  return sigma > 0.0 ? static_cast<float>(1.0 / sigma) : 0.0f;
+}
+
+void MonocularPrior::settle_runs(std::span<MultiViewFrameInput> track, bool past_only) const {
+  for (int b = 0; b < kBodyJoints - 1; ++b) {
+    const auto bone = static_cast<std::size_t>(b);
+    for (std::size_t start = 0; start < track.size();) {
+      if (!lacking(track[start].prior, b)) {
+        ++start;
+        continue;
+      }
+      std::size_t end = start;  // the run is [start, end)
+      while (end < track.size() && lacking(track[end].prior, b)) ++end;
+      for (std::size_t f = start; f < end; ++f) {
+        DirectionPrior& p = track[f].prior;
+        if (!p.few[bone]) continue;
+        p.inv_sigma[bone] = run_weight(past_only ? f + 1 - start : end - start);
+        p.reference[bone] = options_.few_views_reference && p.inv_sigma[bone] > 0.0f &&
+                            p.inv_sigma[bone] == run_weight(SIZE_MAX);
+      }
+      start = end;
+    }
+  }
+}
+
+void MonocularPrior::settle_newest(DirectionPrior* prior, Runs& run) const {
+  for (int b = 0; b < kBodyJoints - 1; ++b) {
+    const auto bone = static_cast<std::size_t>(b);
+    run[bone] = !prior || lacking(*prior, b) ? std::min(run[bone], INT_MAX - 1) + 1 : 0;
+    if (!prior || !prior->few[bone]) continue;
+    prior->inv_sigma[bone] = run_weight(static_cast<std::size_t>(run[bone]));
+    prior->reference[bone] = options_.few_views_reference && prior->inv_sigma[bone] > 0.0f &&
+                             prior->inv_sigma[bone] == run_weight(SIZE_MAX);
+  }
 }
 
 }  // namespace mocap::fit

@@ -11,6 +11,7 @@
 // other do not see depth along their common axis); weak where two views fix it; weakest where
 // three or more views agree. docs/multiview.md "The monocular prior".
 
+#include <array>
 #include <span>
 #include <vector>
 
@@ -35,6 +36,16 @@ struct MonocularPriorOptions {
   // nearly parallel, do not see depth along their axis: the noise is magnified). Exact
   // keypoints are trusted at any angle.
   double max_depth_error_m = 0.1;
+  // The strong weight needs a run of frames: a bone is weighted few_views_rad only where its
+  // ends lacked two good views for at least this many consecutive frames of the track (full
+  // mode: the whole run, both sides of the frame; live: the run up to the frame). A shorter run
+  // (a joint dropped in a frame or two, which the neighbouring frames and the other views fill)
+  // takes two_views_rad. 1: per frame. Chosen on HumanEva-I Train and the virtual scenes of CMU
+  // train clips (docs/multiview.md "The monocular prior").
+  int few_views_frames = 8;
+  // A Cauchy loss on each bone's term, its scale in radians of chord (set in DirectionPrior):
+  // beyond it a retrieval facing or bending the wrong way pulls less and less. <= 0: squared.
+  double robust_rad = 1.0;
   // Bones of the first kind also start from the retrieved direction instead of the triangulated
   // one (worse on HumanEva Train: off).
   bool few_views_reference = false;
@@ -61,7 +72,23 @@ class MonocularPrior {
 
   const MonocularPriorOptions& options() const { return options_; }
 
+  // The run rule over one track's consecutive frames (after add() on each; a frame without a
+  // prior, e.g. the person unseen, counts as lacking views): a bone marked few
+  // (DirectionPrior::few, left as it is) keeps the strong weight only within a run of at least
+  // few_views_frames frames, else it takes the two-views weight. past_only (live): a run counts
+  // only its frames up to the frame weighed. Settling again (e.g. a longer span of the same track)
+  // gives the same weights.
+  void settle_runs(std::span<MultiViewFrameInput> track, bool past_only) const;
+
+  // The same, past only, one frame at a time (a stream): `run` holds each bone's frames lacking
+  // views up to the frame before (zeros for a new track); `prior` is the newest frame's, or none
+  // when the person was not seen.
+  using Runs = std::array<int, kBodyJoints - 1>;
+  void settle_newest(DirectionPrior* prior, Runs& run) const;
+
  private:
+  float run_weight(std::size_t run) const;  // inverse sigma of a few bone in a run this long
+
   const posedb::Database& db_;
   MonocularPriorOptions options_;
   recon::Matcher matcher_;

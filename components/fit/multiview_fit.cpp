@@ -119,6 +119,7 @@ FrameData frame_data(const MultiViewFrameInput& in, const Directions& directions
     d.prior_d[b] = {p.x / len, p.y / len, p.z / len};
     d.prior_inv_sigma[b] = w;
   }
+  d.prior_robust_rad = std::max(0.0, static_cast<double>(in.prior.robust_rad));
   return d;
 }
 

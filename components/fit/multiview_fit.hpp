@@ -39,6 +39,12 @@ struct DirectionPrior {
   // The bone's reference (start, and the fit's own weak direction prior) is this direction
   // instead of the triangulated one: where the views do not fix the bone.
   std::array<bool, kBodyJoints - 1> reference{};
+  // The bone lacked two good views at this frame (MonocularPrior's "few" class, before the
+  // run rule of settle_few_view_runs weighs it).
+  std::array<bool, kBodyJoints - 1> few{};
+  // A Cauchy loss on each bone's term, its scale in radians (of the chord): a retrieval bending
+  // or facing the wrong way pulls with a force that falls off beyond this. <= 0: squared.
+  float robust_rad = 0.0f;
   bool any() const {
     for (const float w : inv_sigma)
       if (w > 0.0f) return true;

@@ -16,8 +16,35 @@ struct MultiViewPeopleFitter::State {
       tracks{options, MultiViewFrameInput{}};
   MultiViewFrameInput input;  // reused
   std::int64_t people = 0;
+  // The monocular prior, and per track id its bones' runs of frames lacking views and the held
+  // frame it was last seen in (a gap longer than max_missed starts a new track: runs from 0).
+  std::optional<MonocularPrior> prior;
+  struct PriorRuns {
+    MonocularPrior::Runs runs{};
+    std::int64_t last = 0;
+  };
+  std::map<int, PriorRuns> prior_runs;
+  std::int64_t prior_frames = 0;
 
-  explicit State(MultiViewPeopleFitOptions o) : options(std::move(o)) {}
+  explicit State(MultiViewPeopleFitOptions o) : options(std::move(o)) {
+    if (options.prior_db) prior.emplace(*options.prior_db, options.prior);
+  }
+
+  // The monocular prior of person `p` of `result` into `input` (a track's frames come in order).
+  void add_prior(int id, std::int64_t t, const multiview::FrameResult& result, std::size_t p) {
+    const bool found = prior->add(input, result.body_of(p), options.fit.cameras);
+    prior_frames += found ? 1 : 0;
+    auto [it, fresh] = prior_runs.try_emplace(id);
+    PriorRuns& track = it->second;
+    if (!fresh && t - track.last > options.max_missed) {
+      track.runs = {};
+    } else if (!fresh) {
+      for (std::int64_t gap = track.last + 1; gap < t; ++gap)
+        prior->settle_newest(nullptr, track.runs);  // frames the person was missed in
+    }
+    track.last = t;
+    prior->settle_newest(found ? &input.prior : nullptr, track.runs);
+  }
 
   void process(const multiview::FrameObservations* observations,
                const multiview::FrameResult* result, const multiview::KeypointSet* set,
@@ -38,6 +65,7 @@ struct MultiViewPeopleFitter::State {
         tracks.see(id, t, [&]() -> const MultiViewFrameInput& {
           multiview_input(*observations, *result, p, *set, input);
           input.time = time;
+          if (prior) add_prior(id, t, *result, p);
           return input;
         });
       }
@@ -80,6 +108,7 @@ std::vector<People3D> MultiViewPeopleFitter::finish() {
 }
 
 std::int64_t MultiViewPeopleFitter::placed() const { return state_->tracks.placed(); }
+std::int64_t MultiViewPeopleFitter::prior_frames() const { return state_->prior_frames; }
 std::size_t MultiViewPeopleFitter::held_frames() const { return state_->tracks.held_frames(); }
 const FitStats& MultiViewPeopleFitter::stats() const { return state_->tracks.stats(); }
 
@@ -87,7 +116,8 @@ std::string MultiViewPeopleFitter::summary() const {
   const State& s = *state_;
   return std::string(s.options.mode == StreamFitMode::live ? "live" : "full") +
          " fit: " + std::to_string(s.tracks.placed()) + " of " + std::to_string(s.people) +
-         " person-frames fitted, " + std::to_string(s.tracks.tracks_started()) + " tracks";
+         " person-frames fitted, " + std::to_string(s.tracks.tracks_started()) + " tracks" +
+         (s.prior ? ", monocular prior in " + std::to_string(s.prior_frames) : std::string());
 }
 
 }  // namespace mocap::fit

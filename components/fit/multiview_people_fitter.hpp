@@ -32,6 +32,7 @@
 #include <vector>
 
 #include "core/messages.hpp"
+#include "fit/monocular_prior.hpp"
 #include "fit/multiview_fit.hpp"
 #include "fit/people_fitter.hpp"
 #include "multiview/observations.hpp"
@@ -49,6 +50,12 @@ struct MultiViewPeopleFitOptions {
   WindowOptions window{300, 30};
   int max_missed = 10;               // frames a person may be missing before their track ends
   SolveBudget stop_budget{5, 0.25};  // a stop's quick solve, for all tracks together
+  // A pose database (the CMU train split): each person-frame also gets the monocular retrieval's
+  // bone directions (fit::MonocularPrior, its options below), strong only where a bone lacked
+  // two good views for a run of frames, counted from the past (a frame is pushed before its
+  // future is known). Null: no prior.
+  std::shared_ptr<const posedb::Database> prior_db;
+  MonocularPriorOptions prior;
 };
 
 class MultiViewPeopleFitter {
@@ -70,8 +77,9 @@ class MultiViewPeopleFitter {
   void stop();                     // no long solve from now on
   std::vector<People3D> finish();  // every frame still held, in order
 
-  std::int64_t placed() const;      // person-frames whose joints are the fit's
-  std::size_t held_frames() const;  // input frames not output yet
+  std::int64_t placed() const;        // person-frames whose joints are the fit's
+  std::int64_t prior_frames() const;  // person-frames with a monocular prior
+  std::size_t held_frames() const;    // input frames not output yet
   const FitStats& stats() const;
   std::string summary() const;  // "live fit: N of M person-frames fitted, T tracks"
 

@@ -25,6 +25,7 @@ TrackFits fit_tracks(std::span<const multiview::FrameObservations> input,
       multiview_input(input[f], results[f], p, set, frame);
       if (prior && prior->add(frame, results[f].body_of(p), options.cameras)) ++out.prior_frames;
     }
+    if (prior) prior->settle_runs(frames, live);
     std::vector<FittedFrame> fitted;
     if (live) {
       MultiViewLiveFitter fitter(options);

@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <memory>
+#include <utility>
 #include <vector>
 
 namespace mocap::fit::detail {
@@ -338,6 +339,14 @@ WindowSummary solve_window(std::span<const WindowFrame> frames, Bones& bones,
   problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   ceres::Problem problem(problem_options);
   const auto robust = std::make_unique<ceres::HuberLoss>(wt.robust);
+  // The direction prior's Cauchy losses, one per scale in sigmas (a handful: one per weight class).
+  std::vector<std::pair<double, std::unique_ptr<ceres::CauchyLoss>>> cauchy;
+  const auto cauchy_loss = [&cauchy](double scale) -> ceres::LossFunction* {
+    if (!(scale > 0.0)) return nullptr;
+    for (const auto& [s, loss] : cauchy)
+      if (s == scale) return loss.get();
+    return cauchy.emplace_back(scale, std::make_unique<ceres::CauchyLoss>(scale)).second.get();
+  };
 
   std::array<Chain, kBodyJoints> chains;
   for (int j = 0; j < kBones; ++j) chains[j] = chain_to(j);
@@ -426,7 +435,7 @@ WindowSummary solve_window(std::span<const WindowFrame> frames, Bones& bones,
                       DirectionCost{d.d0[b], d.prior_d[b], d.prior_inv_sigma[b]})
                       .release())
                   .release(),
-              nullptr, v.w[b].data());
+              cauchy_loss(d.prior_robust_rad * d.prior_inv_sigma[b]), v.w[b].data());
     // Knees.
     for (const auto& [knee, ankle] :
          {std::pair{index(Joint::right_knee), index(Joint::right_ankle)},

@@ -63,6 +63,7 @@ struct FrameData {
   // inverse sigmas (0: no term).
   std::array<std::array<double, 3>, kBones> prior_d{};
   std::array<double, kBones> prior_inv_sigma{};
+  double prior_robust_rad = 0.0;  // Cauchy scale of those terms (radians of chord); 0: squared
 };
 
 using Bones = std::array<double, kBones>;

@@ -9,6 +9,7 @@
 
 #include <bit>
 #include <cmath>
+#include <memory>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -16,6 +17,7 @@
 
 #include "eval/humaneva_multiview.hpp"
 #include "fit/multiview_input.hpp"
+#include "fit/multiview_people_fitter.hpp"
 #include "multiview/rig_reconstruction.hpp"
 #include "support/small_pose_database.hpp"
 
@@ -34,7 +36,13 @@ struct Clip {
   std::vector<Body> truth;                          // HumanEva's world
 };
 
-Clip reconstruct(const posedb::Database& db) {
+// A joint hidden from C2 in one frame only (besides kHidden in every frame).
+struct OneFrameDrop {
+  int joint = -1;
+  std::size_t frame = 0;
+};
+
+Clip reconstruct(const posedb::Database& db, OneFrameDrop drop = {}) {
   const auto folder = test::shared_data() / "eval/humaneva_i_videopose3d";
   const auto cameras = he::load_cameras(folder / he::kCamerasFile);
   const auto sequences =
@@ -61,6 +69,7 @@ Clip reconstruct(const posedb::Database& db) {
       const std::span<float> xyc = obs.add_person(v);
       for (int j = 0; j < kBodyJoints; ++j) {
         if (v == 1 && (j == kHidden[0] || j == kHidden[1])) continue;  // C2 does not see them
+        if (v == 1 && j == drop.joint && f == drop.frame) continue;
         const glm::dvec2 p =
             c.rig[static_cast<std::size_t>(v)].undistort_pixel({in[3 * j], in[3 * j + 1]});
         xyc[3 * j] = static_cast<float>(p.x);
@@ -148,6 +157,105 @@ TEST(MonocularPrior, GivesDepthToAJointSeenByOneCamera) {
   EXPECT_LT(prior_mm, 0.4 * without_mm);
   // The prior decides: turned to the other depth, the arm follows it (the test can fail).
   EXPECT_GT(flipped_mm, prior_mm + 100.0);
+}
+
+TEST(MonocularPrior, IsStrongOnlyWhereViewsLackForARunOfFrames) {
+  MOCAP_REQUIRE_SHARED("eval/humaneva_i_videopose3d/humaneva_cameras.json");
+  MOCAP_REQUIRE_SMALL_DATABASE(path);
+  const posedb::Database db = posedb::Database::open(path);
+  constexpr int kDropped = index(Joint::left_wrist);  // the left forearm's end
+  constexpr std::size_t kDropFrame = 12;
+  const Clip c = reconstruct(db, {kDropped, kDropFrame});
+  ASSERT_FALSE(c.results[kDropFrame].people.empty());
+  ASSERT_LT(c.results[kDropFrame].body_of(0)[kDropped].view_count(), 2);
+  MonocularPrior prior(db);
+  const auto& o = prior.options();
+  ASSERT_GT(o.few_views_frames, 1);
+  ASSERT_LT(static_cast<std::size_t>(o.few_views_frames), kFrames);
+  const float strong = static_cast<float>(1.0 / o.few_views_rad);
+  const float weak = static_cast<float>(1.0 / o.two_views_rad);
+  constexpr int kForearm = kHidden[1];  // the right wrist's bone: C1 only, in every frame
+  for (const bool live : {false, true}) {
+    int with_prior = 0;
+    std::vector<MultiViewFrameInput> track = inputs(c, &prior, false, &with_prior);
+    ASSERT_GE(with_prior, 20);  // all but the frames before the track is confirmed
+    // Per frame, both lack two views where they are hidden.
+    EXPECT_FLOAT_EQ(track[kDropFrame].prior.inv_sigma[kDropped], strong);
+    EXPECT_FLOAT_EQ(track[kDropFrame + 1].prior.inv_sigma[kDropped], weak);
+    // A stream settles frame by frame, the past only: the same weights as live's.
+    std::vector<MultiViewFrameInput> stream = track;
+    MonocularPrior::Runs runs{};
+    for (auto& frame : stream)
+      prior.settle_newest(frame.prior.any() ? &frame.prior : nullptr, runs);
+    prior.settle_runs(track, live);
+    // One dropped frame: the neighbouring frames and C1 fix it; the weak weight.
+    EXPECT_FLOAT_EQ(track[kDropFrame].prior.inv_sigma[kDropped], weak) << "live " << live;
+    EXPECT_TRUE(track[kDropFrame].prior.few[kDropped]);  // the frame's own class is kept
+    if (live) {
+      for (std::size_t f = 0; f < kFrames; ++f)
+        EXPECT_EQ(stream[f].prior.inv_sigma, track[f].prior.inv_sigma) << "frame " << f;
+    }
+    // Settling again gives the same weights.
+    std::vector<MultiViewFrameInput> again = track;
+    prior.settle_runs(again, live);
+    for (std::size_t f = 0; f < kFrames; ++f)
+      EXPECT_EQ(again[f].prior.inv_sigma, track[f].prior.inv_sigma);
+    // Hidden from C2 for the whole second: strong, in live mode once the run is long enough.
+    for (std::size_t f = 0; f < kFrames; ++f) {
+      if (!track[f].prior.any()) continue;  // not tracked yet: counts as lacking views
+      const bool strong_here = !live || f + 1 >= static_cast<std::size_t>(o.few_views_frames);
+      EXPECT_FLOAT_EQ(track[f].prior.inv_sigma[kForearm], strong_here ? strong : weak)
+          << "frame " << f << ", live " << live;
+    }
+  }
+}
+
+// The stream's fitter (multiview.reconstruct's fit) with and without a database, live: the mean
+// error (mm) of the hidden joints over the frames it placed.
+double stream_hidden_error_mm(const Clip& c, std::shared_ptr<const posedb::Database> db) {
+  MultiViewPeopleFitOptions o;
+  o.mode = StreamFitMode::live;
+  o.fit.cameras = c.rig;
+  o.fit.fit = multiview_fit_defaults();
+  o.prior_db = std::move(db);
+  MultiViewPeopleFitter fitter(o);
+  std::vector<People3D> out;
+  for (std::size_t f = 0; f < c.results.size(); ++f) {
+    People3D frame;
+    frame.header.frame = static_cast<std::int64_t>(f);
+    for (const auto& person : c.results[f].people)
+      if (person.id >= 0) frame.people.emplace_back().id = person.id;
+    for (People3D& done :
+         fitter.push(c.input[f], c.results[f], multiview::KeypointSet::body15(), std::move(frame)))
+      out.push_back(std::move(done));
+  }
+  for (People3D& done : fitter.finish()) out.push_back(std::move(done));
+  double sum = 0.0;
+  int n = 0;
+  for (const People3D& frame : out)
+    for (const Person3D& p : frame.people) {
+      if (!p.placed) continue;
+      const auto joints = joints_in_frame(p);
+      for (const int j : kHidden)
+        sum += glm::distance(joints[j], c.truth[static_cast<std::size_t>(frame.header.frame)][j]);
+      n += 2;
+    }
+  EXPECT_GE(n, 2 * 20);
+  return n > 0 ? 1000.0 * sum / n : NAN;
+}
+
+TEST(MonocularPrior, TheStreamFitTakesItWhenGivenADatabase) {
+  MOCAP_REQUIRE_SHARED("eval/humaneva_i_videopose3d/humaneva_cameras.json");
+  MOCAP_REQUIRE_SMALL_DATABASE(path);
+  auto db = std::make_shared<const posedb::Database>(posedb::Database::open(path));
+  const Clip c = reconstruct(*db);
+  const double without_mm = stream_hidden_error_mm(c, nullptr);
+  const double prior_mm = stream_hidden_error_mm(c, db);
+  std::cout << "stream, live: right elbow and wrist seen by C1 only: no database " << without_mm
+            << " mm, with one " << prior_mm << " mm\n";
+  // Runs counted from the past: the first few_views_frames - 1 frames are weak, the rest strong.
+  EXPECT_GT(without_mm, 200.0);
+  EXPECT_LT(prior_mm, 0.6 * without_mm);
 }
 
 TEST(MonocularPrior, WeighsABoneByHowWellTheViewsFixItsEnds) {

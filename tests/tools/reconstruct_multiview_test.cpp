@@ -25,6 +25,7 @@
 #include "support/files.hpp"
 #include "support/mocap_process.hpp"
 #include "support/shared_data.hpp"
+#include "support/small_pose_database.hpp"
 
 namespace mocap::test {
 namespace {
@@ -304,6 +305,31 @@ TEST_F(ReconstructMultiView, ExchangedViewsAndKeypointsOfAnotherSizeAreRefusedNa
   ASSERT_EQ(run("anyway", a, err), 0) << err;
   EXPECT_NE(err.find("warning: view 2 (cam_02"), std::string::npos) << err;
   EXPECT_EQ(lines("anyway").size(), static_cast<std::size_t>(kFrames));
+}
+
+TEST_F(ReconstructMultiView, ADatabaseAddsTheMonocularPriorAndIsCheckedFirst) {
+  MOCAP_REQUIRE_SMALL_DATABASE(db);
+  std::string err;
+  // The prior is part of the fit: refused with --fit off, and an unreadable database is refused
+  // naming it, before the output folder is made.
+  auto off = args("off", views_);
+  off.insert(off.end(), {"--db", db});
+  EXPECT_NE(run("off", off, err), 0);
+  EXPECT_NE(err.find("--db"), std::string::npos) << err;
+  const std::string missing = dir_.file("missing.mdb");
+  auto bad = args("bad", views_, "", "live");
+  bad.insert(bad.end(), {"--db", missing});
+  EXPECT_NE(run("bad", bad, err), 0);
+  EXPECT_NE(err.find(missing), std::string::npos) << err;
+  EXPECT_FALSE(fs::exists(dir_.file("bad")));
+  // Given one, the live fit takes the prior (summary.json names the database) and writes every
+  // frame.
+  auto with = args("with", views_, "", "live");
+  with.insert(with.end(), {"--db", db});
+  ASSERT_EQ(run("with", with, err), 0) << err;
+  EXPECT_EQ(lines("with").size(), static_cast<std::size_t>(kFrames));
+  const json summary = json::parse(read_file(dir_.file("with") + "/summary.json"));
+  EXPECT_EQ(summary.value("prior_db", std::string()), db);
 }
 
 TEST_F(ReconstructMultiView, BadFramesAndAShorterViewLeaveTheOthersGoingOn) {

@@ -2,10 +2,12 @@
 
 #include <unistd.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <map>
 
 #include "core/input_error.hpp"
 
@@ -108,6 +110,40 @@ void print_row(const std::string& name, const std::string& what, const eval::Sco
   std::cout << "| " << name << " | " << what << " | " << std::fixed << std::setprecision(1)
             << s.mpjpe() << " | " << s.pa_mpjpe() << " | " << s.accel() << " | " << s.jitter()
             << " | " << std::setprecision(3) << s.coverage() << " |\n";
+}
+
+void set_prior_option(fit::MonocularPriorOptions& o, const std::string& assignment) {
+  const auto eq = assignment.find('=');
+  if (eq == std::string::npos) throw InputError("--prior-set " + assignment, "expected NAME=VALUE");
+  const std::string name = assignment.substr(0, eq);
+  double value = 0.0;
+  try {
+    value = std::stod(assignment.substr(eq + 1));
+  } catch (const std::exception&) {
+    throw InputError("--prior-set " + assignment, "the value is not a number");
+  }
+  const std::map<std::string, double*> settings = {{"few_views_rad", &o.few_views_rad},
+                                                   {"two_views_rad", &o.two_views_rad},
+                                                   {"many_views_rad", &o.many_views_rad},
+                                                   {"robust_rad", &o.robust_rad},
+                                                   {"max_depth_error_m", &o.max_depth_error_m}};
+  if (name == "few_views_reference") {
+    o.few_views_reference = value != 0.0;
+    return;
+  }
+  if (name == "few_views_frames") {
+    if (!(value >= 1.0 && value <= 10000.0) || value != std::floor(value))
+      throw InputError("--prior-set " + assignment, "a whole number of frames from 1 expected");
+    o.few_views_frames = static_cast<int>(value);
+    return;
+  }
+  const auto found = settings.find(name);
+  if (found == settings.end())
+    throw InputError("--prior-set " + assignment,
+                     "unknown setting " + name +
+                         " (few_views_rad, two_views_rad, many_views_rad, robust_rad, "
+                         "max_depth_error_m, few_views_frames, few_views_reference)");
+  *found->second = value;
 }
 
 }  // namespace mocap::cli

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "eval/virtual_protocol.hpp"
+#include "fit/monocular_prior.hpp"
 #include "posedb/builder.hpp"
 #include "posedb/database.hpp"
 #include "recon/matcher.hpp"
@@ -54,5 +55,10 @@ nlohmann::json scores_json(const eval::Scores& scores);
 
 // One Markdown row: | name | what | MPJPE | PA-MPJPE | accel | jitter | coverage |.
 void print_row(const std::string& name, const std::string& what, const eval::Scores& scores);
+
+// `--prior-set NAME=VALUE`: one setting of the monocular prior (fit::MonocularPriorOptions), for
+// choosing them on train data (mocap eval humaneva-multiview --split train, mocap eval multiview
+// --split train). Throws InputError naming the option.
+void set_prior_option(fit::MonocularPriorOptions& o, const std::string& assignment);
 
 }  // namespace mocap::cli

@@ -1,6 +1,7 @@
 #include "eval_leaks.hpp"
 
 #include <cctype>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <set>
@@ -46,6 +47,18 @@ std::vector<std::string> cmu_heldout_clips(const posedb::Database& db,
       leaks.push_back(clip.name + " (" + clip.family + ")");
   }
   return leaks;
+}
+
+std::vector<std::string> cmu_clips_of_unseen_subjects(const posedb::Database& db,
+                                                      const std::vector<std::string>& files) {
+  std::set<std::string> seen;
+  for (const posedb::ClipInfo& clip : db.clips()) seen.insert(cmu_subject(clip.name));
+  std::vector<std::string> out;
+  for (const std::string& file : files) {
+    const std::string subject = cmu_subject(std::filesystem::path(file).filename().string());
+    if (!subject.empty() && !seen.count(subject)) out.push_back(file);
+  }
+  return out;
 }
 
 std::vector<std::string> humaneva_clips(const posedb::Database& db, std::string_view split) {

@@ -21,6 +21,12 @@ namespace mocap::cli {
 std::vector<std::string> cmu_heldout_clips(const posedb::Database& db,
                                            const std::string& mocap_folder);
 
+// Of the CMU clip files `files`, those whose subject has no clip in `db` (any family): scenes
+// of train clips that a database of the other train subjects never saw (mocap eval multiview
+// --split train).
+std::vector<std::string> cmu_clips_of_unseen_subjects(const posedb::Database& db,
+                                                      const std::vector<std::string>& files);
+
 // The HumanEva clips of `db` from `split` ("Validate" or "Train": their names start "Validate/").
 std::vector<std::string> humaneva_clips(const posedb::Database& db, std::string_view split);
 

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <iomanip>
 #include <iostream>
 #include <limits>
@@ -62,36 +63,6 @@ std::vector<Row> make_rows(bool fit, bool prior, bool monocular) {
     if (fit && prior && set.size() > 1) rows.push_back({set, true, true});
   }
   return rows;
-}
-
-// `--prior-set NAME=VALUE`: a setting of the monocular prior (fit::MonocularPriorOptions), for
-// choosing them on --split train.
-void set_prior_option(fit::MonocularPriorOptions& o, const std::string& assignment) {
-  const auto eq = assignment.find('=');
-  if (eq == std::string::npos) throw InputError("--prior-set " + assignment, "expected NAME=VALUE");
-  const std::string name = assignment.substr(0, eq);
-  double value = 0.0;
-  try {
-    value = std::stod(assignment.substr(eq + 1));
-  } catch (const std::exception&) {
-    throw InputError("--prior-set " + assignment, "the value is not a number");
-  }
-  const std::map<std::string, double*> settings = {{"few_views_rad", &o.few_views_rad},
-                                                   {"two_views_rad", &o.two_views_rad},
-                                                   {"many_views_rad", &o.many_views_rad},
-
-                                                   {"max_depth_error_m", &o.max_depth_error_m}};
-  if (name == "few_views_reference") {
-    o.few_views_reference = value != 0.0;
-    return;
-  }
-  const auto found = settings.find(name);
-  if (found == settings.end())
-    throw InputError("--prior-set " + assignment,
-                     "unknown setting " + name +
-                         " (few_views_rad, two_views_rad, many_views_rad, "
-                         "max_depth_error_m, few_views_reference)");
-  *found->second = value;
 }
 
 // Poses of a monocular fit in the camera frame, placed (absolute joints).
@@ -365,7 +336,8 @@ int humaneva_multiview_command(int argc, char** argv) {
       .flag("no-prior", "no row + fit + monocular prior (the multi-view fit with --db's poses)")
       .option("prior-set", "NAME=VALUE",
               "a setting of the monocular prior (few_views_rad, two_views_rad, many_views_rad, "
-              "max_depth_error_m, few_views_reference 0/1); repeat for several",
+              "robust_rad, max_depth_error_m, few_views_frames, few_views_reference 0/1); "
+              "repeat for several",
               std::nullopt, true)
       .option("split", "NAME",
               "validate (the evaluation) or train (for choosing settings; no other split)",

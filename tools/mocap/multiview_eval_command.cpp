@@ -16,9 +16,11 @@
 #include "core/input_error.hpp"
 #include "eval/multiview_protocol.hpp"
 #include "eval/pose2sim_multiview.hpp"
+#include "eval_configs.hpp"
 #include "eval_leaks.hpp"
 #include "eval_report.hpp"
 #include "output_files.hpp"
+#include "posedb/builder.hpp"
 
 namespace mocap::cli {
 namespace {
@@ -105,8 +107,12 @@ int multiview_eval_command(int argc, char** argv) {
             "ours per frame, ours + tracking,\n+ skeleton fit on all views (full and live). "
             "Default: three sweeps around\n4 views, 3 people, σ 2 % (under a minute); "
             "--full: every combination.");
-  args.option("mocap", "DIR", "cmu31 folder with splits.txt (its heldout clips are used)",
+  args.option("mocap", "DIR", "cmu31 folder with splits.txt (the clips of --split are used)",
               "../shared/data/mocap/cmu31")
+      .option("split", "NAME",
+              "heldout (the evaluation) or train (for choosing settings: the train clips of the "
+              "subjects --db does not hold)",
+              "heldout")
       .option("views", "LIST", "camera counts (e.g. 2,3,4,6,8,16)")
       .option("people", "LIST", "people in the room (e.g. 1,2,3,4,6)")
       .option("noise", "LIST", "2D noise σ, percent of the box height (e.g. 0,1,2,5)")
@@ -118,27 +124,43 @@ int multiview_eval_command(int argc, char** argv) {
       .option("json", "FILE", "where to write all numbers", "eval_multiview.json")
       .option("db", "FILE",
               "pose database (CMU train split): adds the row + skeleton fit + monocular prior")
+      .option("prior-set", "NAME=VALUE",
+              "with --db: a setting of the monocular prior (as mocap eval humaneva-multiview "
+              "--help lists them), for choosing them with --split train; repeat for several",
+              std::nullopt, true)
       .flag("allow-leak",
             "with --db: evaluate even when the database holds held-out CMU clips (refused "
             "otherwise); the results then say so, loudly");
   int code = 0;
   if (!args.parse(argc, argv, code)) return code;
   const auto started = std::chrono::steady_clock::now();
+  const std::string split = args.get("split");
+  if (split != "heldout" && split != "train")
+    throw InputError("--split " + split, "heldout or train expected");
   std::optional<posedb::Database> db;
   LeakCheck leaks;
   if (args.has("db")) {
     db.emplace(posedb::Database::open(args.get("db")));
-    leaks.add(db->path(), cmu_heldout_clips(*db, args.get("mocap")));
+    if (split == "heldout") leaks.add(db->path(), cmu_heldout_clips(*db, args.get("mocap")));
     leaks.enforce(args.has("allow-leak"), "the held-out CMU clips", "mocap eval multiview");
   }
   eval::MultiviewProtocolOptions options;
   options.prior_db = db ? &*db : nullptr;
+  for (const std::string& setting : args.all("prior-set")) set_prior_option(options.prior, setting);
   options.frames = static_cast<int>(args.integer("frames"));
   options.budget_s = args.number("budget");
   options.seed = static_cast<std::uint64_t>(args.integer("seed"));
-  const auto clips = eval::load_heldout_clips(args.get("mocap"), options.fps);
+  // Train scenes (for choosing settings) take only the subjects the database never saw.
+  std::vector<std::string> files = posedb::split_files(args.get("mocap"), split);
+  if (split == "train" && db) files = cmu_clips_of_unseen_subjects(*db, files);
+  if (files.empty())
+    throw InputError(args.get("mocap") + "/splits.txt",
+                     "no " + split + " clips" +
+                         (db ? " of a subject " + args.get("db") + " does not hold" : ""));
+  const auto clips = eval::load_truth(files, options.fps);
   const auto all = cases(args);
   json out = {{"protocol", "multiview"},
+              {"split", split},
               {"command", command_line("mocap eval multiview", argc, argv)},
               {"git_commit", git_commit()},
               {"machine", machine_description()},
@@ -162,8 +184,8 @@ int multiview_eval_command(int argc, char** argv) {
     }
   }
   std::cerr << "\n";
-  std::cout << leaks.markdown_warning()
-            << "## Multi-view, virtual scenes of the held-out CMU clips\n\n"
+  std::cout << leaks.markdown_warning() << "## Multi-view, virtual scenes of the "
+            << (split == "train" ? "train" : "held-out") << " CMU clips\n\n"
             << options.frames << " frame sets at 30 fps per case; 10 % joints dropped, 5 % "
             << "outlier keypoints, false detections (20 % of views and frames), occlusion; "
                "1920x1080 cameras on a 6 m ring (2 and 3 cameras 90 degrees apart). MPJPE in "

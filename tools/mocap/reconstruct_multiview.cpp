@@ -37,6 +37,7 @@
 #include "multiview/rig_reconstruction.hpp"
 #include "multiview/view_check.hpp"
 #include "output_files.hpp"
+#include "posedb/database.hpp"
 #include "progress_bar.hpp"
 #include "reconstruct_report.hpp"
 #include "video/video_source.hpp"
@@ -360,6 +361,7 @@ std::string graph_text(const std::vector<View>& views, const std::string& rig_fi
   }
   g << "  solve: { type: multiview.reconstruct, params: { rig: " << quoted(rig_file)
     << ", fps: " << rate << ", fit: " << fit;
+  if (args.has("db") && fit != "off") g << ", prior_db: " << quoted(args.get("db"));
   // Live: the limiter's set numbers are the frames; a set the limiter passed without a view waits
   // for it this long (longer than a detection takes, or complete sets would go on partial).
   if (live) g << ", sync_by: frame, sync_wait_ms: " << kLiveSolveWaitMs;
@@ -506,6 +508,11 @@ int reconstruct_multiview_command(int argc, char** argv) {
               "as each window is solved), live with a 3-frame lag (a new person's first 30 "
               "frames held for their bone lengths); auto: full for files, live for cameras",
               "auto")
+      .option("db", "FILE",
+              "pose database (the CMU train split, as without --calibration): the skeleton fit "
+              "also takes each person's monocular retrieval from the view that sees them best as "
+              "a prior of the bones that lack two good views for a run of frames "
+              "(docs/multiview.md, \"The monocular prior\"); without it, no prior")
       .option("offsets", "auto|N,N,...",
               "views filmed without a common clock: per view the frames it is shifted by (its "
               "frame i shows the first view's frame i + N), or auto: estimated from the people "
@@ -543,6 +550,11 @@ int reconstruct_multiview_command(int argc, char** argv) {
   refuse_mixed_views(views);
   const bool live = views.front().kind == ViewKind::camera;
   if (fit == "auto") fit = live ? "live" : "full";  // files are fitted offline, cameras with a lag
+  if (args.has("db")) {
+    if (fit == "off")
+      throw InputError("--db", "the monocular prior is part of the fit: not with --fit off");
+    posedb::Database::open(args.get("db"));  // readable, before DIR is touched
+  }
   std::string detector = args.get("detector");
   if (detector == "auto") detector = std::string(live ? kLiveDetector : kFileDetector);
   if (live && args.has("offsets"))
@@ -620,6 +632,7 @@ int reconstruct_multiview_command(int argc, char** argv) {
   summary["fps"] = fps;
   summary["floor"] = floor_how;
   summary["fit"] = fit;
+  summary["prior_db"] = args.has("db") ? json(args.get("db")) : json(nullptr);
   return finish_reconstruct(run, summary, out, frames);
 }
 

@@ -32,7 +32,8 @@ class MultiViewReconstructNode : public Node {
     c.join({{"view"}, SyncKey::frame, 64, 0.0, 0.0, LateMessages::drop});
     c.required_param<std::string>("rig", "rig file: Pose2Sim/anipose TOML or OpenCV YAML");
     declare_reconstruction_params(c);  // volume, fps, report_tentative
-    declare_multiview_fit_params(c);   // fit, lag, bone_frames, window, overlap, max_missed
+    declare_multiview_fit_params(c);   // fit, lag, bone_frames, window, overlap, max_missed,
+                                       // prior_db
   }
 
   void open(Context& ctx) override {

@@ -2,8 +2,10 @@
 // multiview.reconstruct's parameters, declared and read in one place (as the detectors' network
 // parameters are, nodes/detect/network_params.hpp): what the reconstruction takes (volume, fps,
 // report_tentative) and what the skeleton fit takes (fit, lag, bone_frames, window, overlap,
-// max_missed).
+// max_missed, prior_db).
 
+#include <exception>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -12,6 +14,7 @@
 #include "fit/multiview_people_fitter.hpp"
 #include "graph/registry.hpp"
 #include "multiview/rig_reconstruction.hpp"
+#include "posedb/database.hpp"
 
 namespace mocap::nodes {
 
@@ -51,6 +54,9 @@ inline void declare_multiview_fit_params(graph::Contract& c) {
                {0, 99999});
   c.param<int>("max_missed", 10, "fit: frames a person may be missing before their fit ends",
                {0, 10000});
+  c.param<std::string>("prior_db", "",
+                       "fit: pose database (CMU train split) whose monocular retrieval is a prior "
+                       "of the bones few views see (docs/multiview.md); empty: none");
 }
 
 // The fit's options on the rig `solver` reconstructs in (its cameras and floor); nullopt when
@@ -68,6 +74,13 @@ inline std::optional<fit::MultiViewPeopleFitOptions> read_multiview_fit_params(
   o.fit.bone_frames = ctx.param<int>("bone_frames");
   o.window = {ctx.param<int>("window"), ctx.param<int>("overlap")};
   o.max_missed = ctx.param<int>("max_missed");
+  if (const auto db = ctx.param<std::string>("prior_db"); !db.empty()) {
+    try {
+      o.prior_db = std::make_shared<const posedb::Database>(posedb::Database::open(db));
+    } catch (const std::exception& e) {
+      throw InputError(ctx.node_name() + ".prior_db", e.what());
+    }
+  }
   return o;
 }
 
