@@ -71,6 +71,10 @@ struct MultiViewPeopleFitter::State {
       }
     }
     tracks.end_frame(t);
+    // A track missed longer than max_missed starts again from no runs when seen (above): forget
+    // it, so that a long live run keeps only the tracks that can still come back.
+    std::erase_if(prior_runs,
+                  [&](const auto& entry) { return t - entry.second.last > options.max_missed; });
     tracks.release_decided([&](People3D&& f) { out.push_back(std::move(f)); });
   }
 };
