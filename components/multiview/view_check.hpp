@@ -46,9 +46,10 @@ struct ViewCheckOptions {
   // Every camera's median error above this fraction of the person's height in its image (the
   // median over the frames of the tallest person's span of confident keypoints): the rig may
   // not be these views' rig. A detection counts as right within half a head (PCKh@0.5, about 6 %
-  // of the height) and the medians of right detections through a right rig lie well within it
-  // (Pose2Sim's demo: 1-4 %); a tenth leaves room for a rig slightly off, while a wrong rig puts
-  // joints a limb's length away (15 % and more).
+  // of the height), and through a right rig the medians are of that order (Pose2Sim's demo as it
+  // is: 2-6 % per camera, the worst cam_03 whose calibration is off); a tenth leaves room for a
+  // rig slightly off, while a wrong rig puts them much further (the demo against its rig turned
+  // or moved: its best camera at 14-87 %; with 3 cameras two may agree, docs/cameras.md).
   double foreign_rig_fraction = 0.1;
 };
 
