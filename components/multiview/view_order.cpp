@@ -105,9 +105,10 @@ class PairCosts {
             distances.clear();
             for (std::size_t m = 0; m < ra.size() && m < rb.size(); ++m) {
               if (!ra[m].seen || !rb[m].seen) continue;
-              distances.push_back(0.5 *
-                                  (line_distance(epipole_in_j, to_pixels[j], ra[m], rb[m].pixel) +
-                                   line_distance(epipole_in_i, to_pixels[i], rb[m], ra[m].pixel)));
+              const double d =
+                  0.5 * (line_distance(epipole_in_j, to_pixels[j], ra[m], rb[m].pixel) +
+                         line_distance(epipole_in_i, to_pixels[i], rb[m], ra[m].pixel));
+              if (std::isfinite(d)) distances.push_back(d);  // NaN breaks nth_element's order
             }
             if (!distances.empty()) at(a, i, b, j) = median(distances);
           }
