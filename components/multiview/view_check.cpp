@@ -4,15 +4,17 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <numeric>
 #include <utility>
 
 #include "camera/camera.hpp"
+#include "multiview/view_order.hpp"
 
 namespace mocap::multiview {
 namespace {
 
-// Up to this many cameras every view (and pair) is tried, not only the flagged ones: at most 15
-// pairs. With more, the others' consensus outvotes a wrong view, which is then flagged itself.
+// Up to this many cameras every view is tried scaled, not only the flagged ones. With more, the
+// others' consensus outvotes a wrong view, which is then flagged itself.
 constexpr std::size_t kEveryViewUpTo = 6;
 
 bool somebody(const std::vector<camera::BodyKeypoints>& people) { return !people.empty(); }
@@ -84,42 +86,36 @@ std::vector<std::size_t> flagged_views(const ViewErrorReport& report) {
   return out;
 }
 
-bool same_size(const camera::Camera& a, const camera::Camera& b) {
-  return a.width == b.width && a.height == b.height;
-}
-
-// Whether views a and b are candidates: every view with few cameras (an exchange or a scale
-// there spoils every camera's check alike, since the others' triangulation holds the wrong view,
-// and may flag nobody), else the flagged ones.
+// Whether view v is tried scaled: every view with few cameras (a scale there may spoil every
+// camera's check alike and flag nobody), else the flagged ones.
 bool candidate(const ViewErrorReport& report, std::size_t v) {
   return report.views.size() <= kEveryViewUpTo || report.views[v].flagged;
 }
 
-// The exchange of two views of one image size that explains the errors best: the rig's mean
-// error after it (infinity: none explains them).
-double find_exchange(std::span<const camera::Camera> cameras,
-                     std::vector<camera::BodySequence>& views, const ViewErrorReport& given,
-                     const ViewErrorOptions& options, ExchangedViews& found) {
-  double best = std::numeric_limits<double>::infinity();
-  for (std::size_t a = 0; a < views.size(); ++a) {
-    for (std::size_t b = a + 1; b < views.size(); ++b) {
-      if (!(candidate(given, a) || candidate(given, b))) continue;
-      if (!same_size(cameras[a], cameras[b])) continue;
-      std::swap(views[a], views[b]);
-      const ViewErrorReport after = view_errors(cameras, views, options);
-      std::swap(views[a], views[b]);
-      const std::size_t touched[] = {a, b};
-      if (!explains(given, after, touched, options)) continue;
-      const double mean = level(after).mean_px;
-      if (mean >= best) continue;
-      best = mean;
-      found = {a,
-               b,
-               {given.views[a].median_px, given.views[b].median_px},
-               {after.views[a].median_px, after.views[b].median_px}};
-    }
-  }
-  return best;
+// The views moved to the cameras of `camera_of_view`.
+std::vector<camera::BodySequence> reordered(std::vector<camera::BodySequence> views,
+                                            std::span<const std::size_t> camera_of_view) {
+  std::vector<camera::BodySequence> out(views.size());
+  for (std::size_t v = 0; v < views.size(); ++v) out[camera_of_view[v]] = std::move(views[v]);
+  return out;
+}
+
+// The order of the views that agrees best with the rig (view_order.hpp), when it explains the
+// errors: the rig's mean error with it (infinity: the order given stays).
+double find_order(std::span<const camera::Camera> cameras,
+                  const std::vector<camera::BodySequence>& views, const ViewErrorReport& given,
+                  const ViewErrorOptions& options, std::vector<std::size_t>& camera_of_view) {
+  const ViewOrder order = best_view_order(cameras, views, options.min_confidence);
+  std::vector<std::size_t> moved;
+  for (std::size_t v = 0; v < views.size(); ++v)
+    if (order.camera_of_view[v] != v) moved.push_back(v);
+  if (moved.empty()) return std::numeric_limits<double>::infinity();
+  const ViewErrorReport after =
+      view_errors(cameras, reordered(views, order.camera_of_view), options);
+  // The cameras given another view are those the moved views left.
+  if (!explains(given, after, moved, options)) return std::numeric_limits<double>::infinity();
+  camera_of_view = order.camera_of_view;
+  return level(after).mean_px;
 }
 
 // The factor s that takes the view's keypoints (about the image origin) closest to where the
@@ -201,7 +197,76 @@ std::string px(double value) {
   return text;
 }
 
+// "the views look given in the order 4 3 2 1 of the rig's cameras (...)", the moved views' errors
+// and the order to give them in.
+std::string describe_order(const ReorderedViews& r, std::span<const camera::Camera> cameras,
+                           std::span<const std::string> labels) {
+  const std::vector<std::size_t> moved = r.moved();
+  std::string text;
+  if (moved.size() == 2) text = labels[moved[0]] + " and " + labels[moved[1]] + " look exchanged: ";
+  std::string order, names, before, after, give;
+  std::vector<std::size_t> view_at(r.camera_of_view.size());
+  for (std::size_t v = 0; v < r.camera_of_view.size(); ++v) {
+    const std::string space = v ? " " : "";
+    order += space + std::to_string(r.camera_of_view[v] + 1);
+    names += space + cameras[r.camera_of_view[v]].name;
+    view_at[r.camera_of_view[v]] = v;
+  }
+  for (const std::size_t v : moved) {
+    before += (before.empty() ? "" : ", ") + px(r.before_px[v]);
+    after += (after.empty() ? "" : ", ") + px(r.after_px[v]);
+  }
+  for (const std::size_t v : view_at) give += (give.empty() ? "" : ", ") + labels[v];
+  return text + "the views look given in the order " + order + " of the rig's cameras (" + names +
+         "): the moved views' errors " + before + " px as given, " + after +
+         " px reordered; give them as " + give;
+}
+
+std::string describe_foreign_rig(const ViewCheck& check, std::span<const std::string> labels) {
+  std::string errors;
+  for (std::size_t v = 0; v < check.explained_errors.views.size(); ++v) {
+    const ViewError& e = check.explained_errors.views[v];
+    if (e.points == 0) continue;
+    errors += (errors.empty() ? "" : ", ") + labels[v] + " " + px(e.median_px) + " px of " +
+              px(check.person_height_px[v]);
+  }
+  return "every camera disagrees with the others by more than a tenth of the person's height in "
+         "its image (" +
+         errors + ")" + (check.explained() ? ", even with the views' explanation above" : "") +
+         ": the rig may not be these views' rig; check the calibration file and that the views "
+         "come from its cameras";
+}
+
 }  // namespace
+
+// Per camera the median over the frames of the tallest person's height in its image.
+std::vector<double> person_heights(std::span<const camera::BodySequence> views,
+                                   double min_confidence) {
+  std::vector<double> out;
+  for (const camera::BodySequence& view : views) {
+    std::vector<double> heights;
+    for (const auto& people : view) {
+      const TallestPerson tallest = tallest_person(people, min_confidence);
+      if (tallest.index >= 0) heights.push_back(tallest.height_px);
+    }
+    out.push_back(median(heights));
+  }
+  return out;
+}
+
+// Every camera with points (at least 3) disagrees with the others by more than `fraction` of the
+// person's height in its image.
+bool every_camera_far_off(const ViewErrorReport& report, std::span<const double> heights,
+                          double fraction) {
+  std::size_t cameras = 0;
+  for (std::size_t v = 0; v < report.views.size(); ++v) {
+    const ViewError& e = report.views[v];
+    if (e.points == 0) continue;
+    if (!(e.median_px > fraction * heights[v])) return false;
+    ++cameras;
+  }
+  return cameras >= 3;
+}
 
 ViewCheck check_views(std::span<const camera::Camera> cameras,
                       std::span<const camera::BodySequence> given,
@@ -214,38 +279,58 @@ ViewCheck check_views(std::span<const camera::Camera> cameras,
     check.errors.frames = std::min_element(given.begin(), given.end(), [](auto& a, auto& b) {
                             return a.size() < b.size();
                           })->size();
-  // Round by round the explanation, exchange or scale, that leaves the lowest mean error is
-  // applied, until none explains what is left (a view scaled and another pair exchanged can
-  // mimic each other with three cameras: the better one wins).
+  // Round by round the explanation, another order or a scale, that leaves the lowest mean error
+  // is applied, until none explains what is left (a view scaled and two views exchanged can
+  // mimic each other with three cameras: the better one wins). given_at[c]: the view given that
+  // camera c now holds.
+  std::vector<std::size_t> given_at(views.size());
+  std::iota(given_at.begin(), given_at.end(), 0);
   ViewErrorReport current = check.errors;
   for (std::size_t round = 0; round < views.size(); ++round) {
-    ExchangedViews exchange;
+    std::vector<std::size_t> order;
     ScaledView scale;
-    const double by_exchange = find_exchange(cameras, views, current, options.errors, exchange);
+    const double by_order = find_order(cameras, views, current, options.errors, order);
     const double by_scale = find_scale(cameras, views, current, options, scale);
-    if (!std::isfinite(std::min(by_exchange, by_scale))) break;
-    if (by_exchange <= by_scale) {
-      std::swap(views[exchange.first], views[exchange.second]);
-      check.exchanged.push_back(exchange);
+    if (!std::isfinite(std::min(by_order, by_scale))) break;
+    if (by_order <= by_scale) {
+      views = reordered(std::move(views), order);
+      std::vector<std::size_t> was = given_at;
+      for (std::size_t c = 0; c < views.size(); ++c) given_at[order[c]] = was[c];
     } else {
       views[scale.view] = scaled(views[scale.view], scale.factor);
+      scale.view = given_at[scale.view];
       check.scaled.push_back(scale);
     }
     current = view_errors(cameras, views, options.errors);
   }
   check.explained_errors = current;
   check.unexplained = flagged_views(current);
+  if (!std::is_sorted(given_at.begin(), given_at.end())) {
+    ReorderedViews& r = check.reordered.emplace();
+    r.camera_of_view.resize(views.size());
+    for (std::size_t c = 0; c < views.size(); ++c) r.camera_of_view[given_at[c]] = c;
+    for (std::size_t v = 0; v < views.size(); ++v) {
+      r.before_px.push_back(check.errors.views[v].median_px);
+      r.after_px.push_back(current.views[r.camera_of_view[v]].median_px);
+    }
+  }
+  check.person_height_px = person_heights(views, options.errors.min_confidence);
+  check.foreign_rig =
+      every_camera_far_off(current, check.person_height_px, options.foreign_rig_fraction);
   return check;
+}
+
+std::vector<std::size_t> ReorderedViews::moved() const {
+  std::vector<std::size_t> out;
+  for (std::size_t v = 0; v < camera_of_view.size(); ++v)
+    if (camera_of_view[v] != v) out.push_back(v);
+  return out;
 }
 
 std::vector<std::string> describe(const ViewCheck& check, std::span<const camera::Camera> cameras,
                                   std::span<const std::string> labels) {
   std::vector<std::string> lines;
-  for (const ExchangedViews& e : check.exchanged)
-    lines.push_back(labels[e.first] + " and " + labels[e.second] +
-                    " look exchanged: their errors " + px(e.before_px[0]) + " and " +
-                    px(e.before_px[1]) + " px as given, " + px(e.after_px[0]) + " and " +
-                    px(e.after_px[1]) + " px exchanged; give the views in the rig's camera order");
+  if (check.reordered) lines.push_back(describe_order(*check.reordered, cameras, labels));
   for (const ScaledView& s : check.scaled) {
     const camera::Camera& c = cameras[s.view];
     char factor[32];
@@ -262,8 +347,9 @@ std::vector<std::string> describe(const ViewCheck& check, std::span<const camera
     lines.push_back(labels[v] + ": error " + px(check.explained_errors.views[v].median_px) +
                     " px, far worse than the other cameras' " +
                     px(others_median(check.explained_errors, v)) +
-                    " px, not explained by an exchange of views or another image size: check its "
-                    "calibration (pose, intrinsics) and its keypoints");
+                    " px, not explained by another order of the views or another image size: check "
+                    "its calibration (pose, intrinsics) and its keypoints");
+  if (check.foreign_rig) lines.push_back(describe_foreign_rig(check, labels));
   return lines;
 }
 

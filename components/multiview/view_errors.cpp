@@ -19,10 +19,11 @@ double median(std::vector<double> values) {
   return *middle;
 }
 
-// The frame's tallest person by the vertical span of its confident keypoints; -1: nobody.
-int tallest(const std::vector<camera::BodyKeypoints>& people, double min_confidence) {
-  int best = -1;
-  float best_span = -1;
+}  // namespace
+
+TallestPerson tallest_person(const std::vector<camera::BodyKeypoints>& people,
+                             double min_confidence) {
+  TallestPerson best;
   for (std::size_t p = 0; p < people.size(); ++p) {
     float top = std::numeric_limits<float>::max(), bottom = std::numeric_limits<float>::lowest();
     for (const Keypoint2D& k : people[p]) {
@@ -30,15 +31,13 @@ int tallest(const std::vector<camera::BodyKeypoints>& people, double min_confide
       top = std::min(top, k.y);
       bottom = std::max(bottom, k.y);
     }
-    if (bottom >= top && bottom - top > best_span) {
-      best_span = bottom - top;
-      best = static_cast<int>(p);
+    if (bottom >= top && (best.index < 0 || bottom - top > best.height_px)) {
+      best.height_px = bottom - top;
+      best.index = static_cast<int>(p);
     }
   }
   return best;
 }
-
-}  // namespace
 
 ViewResiduals view_residuals(std::span<const camera::Camera> cameras,
                              std::span<const camera::BodySequence> views,
@@ -58,7 +57,7 @@ ViewResiduals view_residuals(std::span<const camera::Camera> cameras,
   std::vector<int> person(views.size());
   for (std::size_t f = 0; f < out.frames; ++f) {
     for (std::size_t v = 0; v < views.size(); ++v)
-      person[v] = tallest(views[v][f], options.min_confidence);
+      person[v] = tallest_person(views[v][f], options.min_confidence).index;
     if (std::find(person.begin(), person.end(), -1) != person.end()) continue;
     ++out.frames_used;
     for (int j = 0; j < kBodyJoints; ++j) {

@@ -41,6 +41,15 @@ struct ViewErrorReport {
   std::size_t frames = 0;        // frames in the shortest view
 };
 
+// The tallest person of a frame, by the vertical span of its confident keypoints (index -1:
+// nobody), and that span.
+struct TallestPerson {
+  int index = -1;
+  float height_px = 0;
+};
+TallestPerson tallest_person(const std::vector<camera::BodyKeypoints>& people,
+                             double min_confidence);
+
 // One joint seen by a camera: its keypoint as read (distorted pixels) and where the joint
 // triangulated from the other cameras projects (undistorted pixels), with the keypoint undistorted.
 struct ViewResidual {

@@ -285,7 +285,11 @@ TEST_F(ReconstructMultiView, ExchangedViewsAndKeypointsOfAnotherSizeAreRefusedNa
                      ") look exchanged"),
             std::string::npos)
       << err;
-  EXPECT_NE(err.find("give the views in the rig's camera order"), std::string::npos) << err;
+  // The order to give them in: view 3 (given cam2's folder) second.
+  EXPECT_NE(err.find("give them as view 1 (cam_01, " + views_[0] + "), view 3 (cam_03, " +
+                     views_[1] + "), view 2 (cam_02, " + views_[2] + ")"),
+            std::string::npos)
+      << err;
   EXPECT_FALSE(fs::exists(dir_.file("exchanged"))) << "refused before the output is made";
 
   std::vector<std::string> resized = views_;

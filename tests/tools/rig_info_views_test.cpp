@@ -52,7 +52,9 @@ TEST_F(RigInfoViews, GivesEachCameraItsErrorAgainstTheOthers) {
   // cam_03's calibration is off (docs/cameras.md, frame offsets): worse than cam_02 by far.
   EXPECT_GT(cam03, 2 * cam02) << out;
   EXPECT_EQ(out.find("exchanged"), std::string::npos) << out;
+  EXPECT_EQ(out.find("look given in the order"), std::string::npos) << out;
   EXPECT_EQ(out.find("another image size"), std::string::npos) << out;
+  EXPECT_EQ(out.find("the rig may not be"), std::string::npos) << out;
 }
 
 TEST_F(RigInfoViews, SaysWhichViewsLookExchanged) {
@@ -60,6 +62,13 @@ TEST_F(RigInfoViews, SaysWhichViewsLookExchanged) {
   Mocap info(dir_, "exchanged", a);
   ASSERT_EQ(info.wait(std::chrono::seconds(60)), 0) << info.err();
   EXPECT_NE(info.out().find("view 2 (cam_02) and view 3 (cam_03) look exchanged"),
+            std::string::npos)
+      << info.out();
+  EXPECT_NE(info.out().find("the views look given in the order 1 3 2 4 of the rig's cameras"),
+            std::string::npos)
+      << info.out();
+  EXPECT_NE(info.out().find("give them as view 1 (cam_01), view 3 (cam_03), view 2 (cam_02), "
+                            "view 4 (cam_04)"),
             std::string::npos)
       << info.out();
 }

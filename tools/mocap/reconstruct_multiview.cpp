@@ -171,10 +171,12 @@ void check_camera_view(View& view, const std::string& rig_file, const Args& args
 // of them in which every view shows somebody, at most ViewCheckOptions::max_frames, a bounded time.
 constexpr std::int64_t kCheckedFrames = 300;
 
-// JSON views checked against each other before anything is written: two views exchanged or a
-// view's keypoints made at another image size are refused, naming them and the errors (unless
-// --ignore-view-check: then printed as a warning); a camera far worse than the rest that neither
-// explains is a warning only (the rig may be off, which the run cannot mend but may live with).
+// JSON views checked against each other before anything is written: views given in another order
+// than the rig's cameras (any permutation) or a view's keypoints made at another image size are
+// refused, naming them, the order to give them in and the errors (unless --ignore-view-check:
+// then printed as a warning); a camera far worse than the rest that neither explains, or every
+// camera far off (the rig may not be these views'), is a warning only (the rig may be off, which
+// the run cannot mend but may live with).
 // The views are taken as the graph joins them: view i's frame t - offset at frame t.
 void check_views_agree(const std::vector<View>& views, bool ignore) {
   std::vector<camera::Camera> cameras;
@@ -528,9 +530,9 @@ int reconstruct_multiview_command(int argc, char** argv) {
               "override a node parameter of the graph (e.g. solve.volume=x0,y0,z0,x1,y1,z1)",
               std::nullopt, true)
       .flag("ignore-view-check",
-            "go on when OpenPose JSON views look exchanged or made at another image size than "
-            "their camera's (checked on their first frames with everybody in view; "
-            "docs/multiview.md), with a warning instead of refusing")
+            "go on when OpenPose JSON views look given in another order than the rig's cameras "
+            "or made at another image size than their camera's (checked on their first frames "
+            "with everybody in view; docs/multiview.md), with a warning instead of refusing")
       .flag("quiet", "do not print statistics");
   int code = 0;
   if (!args.parse(argc, argv, code)) return code;

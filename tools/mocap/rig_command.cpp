@@ -104,8 +104,10 @@ int info(int argc, char** argv) {
             "rig's order; at least 3), also the reprojection error per camera: its keypoints "
             "against\nthe joints triangulated from the other cameras (median, mean, points), a "
             "camera far worse\nthan the rest flagged, and what explains it when something "
-            "does: two views exchanged, or\na view's keypoints made at another image size "
-            "(the factor and the size) (docs/cameras.md).");
+            "does: the views given in another order\n(any permutation among cameras of one size: "
+            "the order to give them in), or a view's keypoints\nmade at another image size "
+            "(the factor and the size); and when every camera is far off, that\nthe rig may not "
+            "be these views' rig (docs/cameras.md).");
   args.positional("RIG", "the rig file")
       .positional("VIEW", "OpenPose JSON folders, one per camera of the rig, in its order", true,
                   false)
