@@ -20,13 +20,14 @@ const std::vector<DetectorPreset>& detector_presets();
 // Throws std::invalid_argument listing the names when `name` is unknown.
 const DetectorPreset& detector_preset(std::string_view name);
 
-// The defaults (docs/detection-strategies.md): for a file, find people first: top-down (recall
-// 0.80 against 0.02 for MultiPose 256 and 0.54 for 512 on vtest, faster than 512;
-// graphs/monocular_video.yaml carries it). For a live source, keep the rate: MultiPose 256, the
-// only strategy measured to keep vtest's 10 frames/s live (2026-11-26: top-down runs at 4-5
-// frames/s under the shared machine's load, topdown-flow at about twice that but finds fewer
-// people correctly). Each is a one-line change.
-inline constexpr std::string_view kFileDetector = "topdown";
+// The defaults (docs/detection-strategies.md): for a file, find people first: top-down with
+// BlazePose full in the crops (recall on video.avi 0.366 against 0.251 with MoveNet lightning, at
+// least as high on vtest.avi, vtest_part0 and the COCO stills, precision >= 0.95 on each;
+// 0.80-0.87x its frames/s end to end; graphs/monocular_video.yaml carries it). For a live source,
+// keep the rate: MultiPose 256, the only strategy measured to keep vtest's 10 frames/s live
+// (2026-11-26: top-down runs at 4-5 frames/s under the shared machine's load, topdown-flow at about
+// twice that but finds fewer people correctly). Each is a one-line change.
+inline constexpr std::string_view kFileDetector = "topdown-blaze";
 inline constexpr std::string_view kLiveDetector = "multipose";
 
 // "a, b, c": the names, for help texts and errors.
