@@ -19,6 +19,7 @@
 #include "fit/multiview_input.hpp"
 #include "fit/multiview_people_fitter.hpp"
 #include "multiview/rig_reconstruction.hpp"
+#include "stream_fit.hpp"
 #include "support/small_pose_database.hpp"
 
 namespace mocap::fit {
@@ -219,17 +220,7 @@ double stream_hidden_error_mm(const Clip& c, std::shared_ptr<const posedb::Datab
   o.fit.fit = multiview_fit_defaults();
   o.prior_db = std::move(db);
   MultiViewPeopleFitter fitter(o);
-  std::vector<People3D> out;
-  for (std::size_t f = 0; f < c.results.size(); ++f) {
-    People3D frame;
-    frame.header.frame = static_cast<std::int64_t>(f);
-    for (const auto& person : c.results[f].people)
-      if (person.id >= 0) frame.people.emplace_back().id = person.id;
-    for (People3D& done :
-         fitter.push(c.input[f], c.results[f], multiview::KeypointSet::body15(), std::move(frame)))
-      out.push_back(std::move(done));
-  }
-  for (People3D& done : fitter.finish()) out.push_back(std::move(done));
+  const std::vector<People3D> out = test::fit_stream(fitter, c.input, c.results);
   double sum = 0.0;
   int n = 0;
   for (const People3D& frame : out)

@@ -6,7 +6,6 @@
 #include <cmath>
 #include <iostream>
 #include <map>
-#include <numeric>
 #include <stdexcept>
 #include <vector>
 
@@ -17,6 +16,7 @@
 #include "fit/multiview_people_fitter.hpp"
 #include "fit/scene_fit.hpp"
 #include "multiview/scene_fixture.hpp"
+#include "stream_fit.hpp"
 
 namespace mocap::fit {
 namespace {
@@ -119,27 +119,6 @@ double median(std::vector<double> v) {
   return v.empty() ? 0.0 : v[v.size() / 2];
 }
 
-// Pushes scene `s`'s frames `frames` (indices into the scene) through `fitter`, frame i numbered
-// `numbers[i]`, then finishes it: every set it emitted, in order.
-std::vector<People3D> fit_stream(MultiViewPeopleFitter& fitter, const Scene& s,
-                                 const std::vector<std::size_t>& frames,
-                                 const std::vector<std::int64_t>& numbers) {
-  std::vector<People3D> out;
-  for (std::size_t i = 0; i < frames.size(); ++i) {
-    const std::size_t f = frames[i];
-    People3D frame;
-    frame.header.frame = numbers[i];
-    frame.header.seq = i;
-    for (const auto& person : s.results[f].people)
-      if (person.id >= 0) frame.people.emplace_back().id = person.id;
-    for (People3D& done :
-         fitter.push(s.input[f], s.results[f], multiview::KeypointSet::body15(), std::move(frame)))
-      out.push_back(std::move(done));
-  }
-  for (People3D& done : fitter.finish()) out.push_back(std::move(done));
-  return out;
-}
-
 TEST(MultiViewFit, FullModeWindowsJoinAsSmoothlyAsTheyMoveInside) {
   MOCAP_REQUIRE_SCENE_CLIPS();
   // The stream's full mode (MultiViewPeopleFitter) in windows of 30 sets, 10 of them solved again
@@ -152,10 +131,7 @@ TEST(MultiViewFit, FullModeWindowsJoinAsSmoothlyAsTheyMoveInside) {
   o.fit = options_for(s);
   o.window = {30, 10};
   MultiViewPeopleFitter fitter(o);
-  std::vector<std::size_t> frames(s.results.size());
-  std::iota(frames.begin(), frames.end(), std::size_t{0});
-  const std::vector<People3D> out =
-      fit_stream(fitter, s, frames, std::vector<std::int64_t>(frames.begin(), frames.end()));
+  const std::vector<People3D> out = test::fit_stream(fitter, s.input, s.results);
   ASSERT_EQ(out.size(), s.results.size());
   // Per track, its fitted joints by frame; the acceleration |p(f+1) - 2 p(f) + p(f-1)| of every
   // joint at the two frames either side of a join (frames 20k - 1 and 20k of the track: windows
@@ -197,7 +173,7 @@ std::map<std::pair<std::size_t, int>, Body> live_fit(const Scene& s,
   o.mode = StreamFitMode::live;
   o.fit = options_for(s);
   MultiViewPeopleFitter fitter(o);
-  const std::vector<People3D> out = fit_stream(fitter, s, frames, numbers);
+  const std::vector<People3D> out = test::fit_stream(fitter, s.input, s.results, frames, numbers);
   std::map<std::pair<std::size_t, int>, Body> fitted;
   for (const People3D& frame : out)
     for (const Person3D& p : frame.people)

@@ -89,6 +89,13 @@ std::pair<int, double> closest(const cv::Mat& frame, const std::vector<cv::Mat>&
   return best;
 }
 
+// How the tests open a stream: 5 s to answer (the test server answers in well under one).
+video::SourceOptions stream_options() {
+  video::SourceOptions options;
+  options.timeout_ms = 5000;
+  return options;
+}
+
 #define MOCAP_REQUIRE_SERVER(server) \
   if (!(server).problem().empty()) GTEST_SKIP() << (server).problem()
 
@@ -97,8 +104,7 @@ TEST(RtspSource, ReadsTheLiveStreamsFramesInOrderAtItsRateThenItsEnd) {
   const TempDir dir;
   RtspServer server(dir, "server", vtest_stream(60, false));
   MOCAP_REQUIRE_SERVER(server);
-  video::SourceOptions options;
-  options.timeout_ms = 5000;
+  const video::SourceOptions options = stream_options();
   video::VideoSource source(server.url(), options);
   EXPECT_EQ(source.kind(), video::SourceKind::network);
   EXPECT_TRUE(source.live());
@@ -151,8 +157,7 @@ TEST(RtspSource, AServerThatGoesAwayEndsTheReadWithinTheTimeout) {
   const TempDir dir;
   RtspServer server(dir, "server", vtest_stream(20, true));
   MOCAP_REQUIRE_SERVER(server);
-  video::SourceOptions options;
-  options.timeout_ms = 5000;
+  const video::SourceOptions options = stream_options();
   video::VideoSource source(server.url(), options);
   for (int i = 0; i < 5; ++i) ASSERT_TRUE(source.read()) << server.log();
   server.stop();
@@ -182,8 +187,7 @@ TEST(RtspPlayback, ALostStreamIsOpenedAgainWhenItsServerReturnsAndNumbersOn) {
   served.port = free_tcp_port();
   std::optional<RtspServer> server(std::in_place, dir, "first", served);
   MOCAP_REQUIRE_SERVER(*server);
-  video::SourceOptions options;
-  options.timeout_ms = 5000;
+  const video::SourceOptions options = stream_options();
   video::PlaybackOptions reconnecting;
   reconnecting.reconnect_ms = 200;
   video::Playback playback(server->url(), options, reconnecting);
