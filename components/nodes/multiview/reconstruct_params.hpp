@@ -4,7 +4,6 @@
 // report_tentative) and what the skeleton fit takes (fit, lag, bone_frames, window, overlap,
 // max_missed, prior_db).
 
-#include <exception>
 #include <memory>
 #include <optional>
 #include <string>
@@ -74,13 +73,9 @@ inline std::optional<fit::MultiViewPeopleFitOptions> read_multiview_fit_params(
   o.fit.bone_frames = ctx.param<int>("bone_frames");
   o.window = {ctx.param<int>("window"), ctx.param<int>("overlap")};
   o.max_missed = ctx.param<int>("max_missed");
-  if (const auto db = ctx.param<std::string>("prior_db"); !db.empty()) {
-    try {
-      o.prior_db = std::make_shared<const posedb::Database>(posedb::Database::open(db));
-    } catch (const std::exception& e) {
-      throw InputError(ctx.node_name() + ".prior_db", e.what());
-    }
-  }
+  // Database::open names the file in its errors, the runtime the node, as for every db param.
+  if (const auto db = ctx.param<std::string>("prior_db"); !db.empty())
+    o.prior_db = std::make_shared<const posedb::Database>(posedb::Database::open(db));
   return o;
 }
 
