@@ -248,9 +248,10 @@ int main(int argc, char** argv) {
   // Before any thread starts (user namespaces require a single-threaded process).
   const std::string loopback = test::enter_private_loopback(8);
   cli::Args args("mocap-bench-rig-live [options]",
-                 "Fake GigE cameras joined by capture time for minutes; one killed and restarted.");
+                 "Fake GigE cameras (or RTSP servers) joined by capture time for minutes; one "
+                 "killed and restarted.");
   args.option("seconds", "S", "run length", "300", cli::Range::at_least(12))
-      .option("cameras", "N", "fake cameras (2..8)", "4", cli::Range::count(2, 8))
+      .option("cameras", "N", "cameras (2..8)", "4", cli::Range::count(2, 8))
       .option("fps", "F", "frame rate of every camera", "30", cli::Range::between(1, 120))
       .option("tolerance-ms", "MS", "sync_tolerance_ms", "10", cli::Range::positive())
       .option("wait-ms", "MS", "sync_wait_ms", "200", cli::Range::positive())
