@@ -116,12 +116,18 @@ std::int64_t MultiViewPeopleFitter::prior_frames() const { return state_->prior_
 std::size_t MultiViewPeopleFitter::held_frames() const { return state_->tracks.held_frames(); }
 const FitStats& MultiViewPeopleFitter::stats() const { return state_->tracks.stats(); }
 
+const FrameTimes& MultiViewPeopleFitter::frame_times() const {
+  return state_->tracks.frame_times();
+}
+
 std::string MultiViewPeopleFitter::summary() const {
   const State& s = *state_;
   return std::string(s.options.mode == StreamFitMode::live ? "live" : "full") +
          " fit: " + std::to_string(s.tracks.placed()) + " of " + std::to_string(s.people) +
          " person-frames fitted, " + std::to_string(s.tracks.tracks_started()) + " tracks" +
-         (s.prior ? ", monocular prior in " + std::to_string(s.prior_frames) : std::string());
+         (s.prior ? ", monocular prior in " + std::to_string(s.prior_frames) : std::string()) +
+         (s.tracks.frame_times().count() ? ", " + s.tracks.frame_times().describe("frame set")
+                                         : std::string());
 }
 
 }  // namespace mocap::fit

@@ -179,12 +179,16 @@ const FitStats& PeopleFitter::stats() const { return state_->tracks.stats(); }
 std::optional<mocap::GroundPlane> PeopleFitter::ground() const { return state_->ground; }
 const std::string& PeopleFitter::ground_source() const { return state_->ground_source; }
 
+const FrameTimes& PeopleFitter::frame_times() const { return state_->tracks.frame_times(); }
+
 std::string PeopleFitter::summary() const {
   const State& s = *state_;
+  const std::string times = s.tracks.frame_times().describe("frame");
   return std::to_string(s.tracks.placed()) + " person-frames fitted" +
          (s.ground ? ", floor " + s.ground_source + ": camera " + std::to_string(s.ground->offset) +
                          " m above it"
-                   : std::string(", no floor"));
+                   : std::string(", no floor")) +
+         (times.empty() ? std::string() : ", " + times);
 }
 
 }  // namespace mocap::fit

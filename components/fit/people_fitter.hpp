@@ -28,6 +28,7 @@
 
 #include "core/messages.hpp"
 #include "fit/foot_contact.hpp"
+#include "fit/frame_times.hpp"
 #include "fit/skeleton_fit.hpp"
 
 namespace mocap::fit {
@@ -68,7 +69,10 @@ class PeopleFitter {
   const FitStats& stats() const;                     // of every solve so far
   std::optional<mocap::GroundPlane> ground() const;  // the floor (camera frame), once known
   const std::string& ground_source() const;  // "calibrated", "estimated from the feet (...)"
-  // "N person-frames fitted, floor SOURCE: camera H m above it" (or ", no floor").
+  // How long each input frame took (taken in to pushed into the fitters, solves included).
+  const FrameTimes& frame_times() const;
+  // "N person-frames fitted, floor SOURCE: camera H m above it" (or ", no floor"), then ", per
+  // frame p50 A ms, p95 B ms".
   std::string summary() const;
 
  private:

@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "core/messages.hpp"
+#include "fit/frame_times.hpp"
 #include "fit/people_fitter.hpp"
 #include "fit/skeleton_fit.hpp"
 #include "recon/held_frames.hpp"
@@ -48,8 +49,10 @@ class TrackFitters {
   TrackFitters(const Options& options, Input gap, OnPlaced on_placed = {})
       : options_(options), gap_(std::move(gap)), on_placed_(std::move(on_placed)) {}
 
-  // Holds a frame until each of `ids` is decided in it; returns its index.
+  // Holds a frame until each of `ids` is decided in it; returns its index. The frame's time
+  // (frame_times()) runs from here to its end_frame().
   std::int64_t hold(People3D frame, std::vector<int> ids) {
+    times_.start();
     return held_.hold(std::move(frame), std::move(ids));
   }
   const People3D& frame(std::int64_t t) { return *held_.find(t); }
@@ -84,6 +87,7 @@ class TrackFitters {
         ++it;
       }
     }
+    times_.stop();
   }
 
   // A stop is under way: windows wait for finish_all(), which then solves them quickly.
@@ -133,6 +137,7 @@ class TrackFitters {
   std::size_t held_frames() const { return held_.size(); }
   std::int64_t placed() const { return placed_; }  // person-frames placed
   std::int64_t tracks_started() const { return started_; }
+  const FrameTimes& frame_times() const { return times_; }  // hold() to end_frame(), per frame
   FitStats& stats() { return stats_; }  // of the finished tracks (the owner may add its own)
   const FitStats& stats() const { return stats_; }
 
@@ -210,6 +215,7 @@ class TrackFitters {
   bool stopping_ = false;
   std::int64_t placed_ = 0, started_ = 0;
   FitStats stats_;
+  FrameTimes times_;
 };
 
 }  // namespace mocap::fit

@@ -231,6 +231,7 @@ NodeStats Harness::Impl::snapshot() const {
   const std::lock_guard lock(mutex);
   s.status = status;
   s.sync = sync_copy;
+  s.drops += late_dropped(s.sync);
   return s;
 }
 

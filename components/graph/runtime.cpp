@@ -213,6 +213,7 @@ class NodeRunner final : public Context {
       const std::lock_guard lock(status_mutex_);  // the synchroniser's counters change as it runs
       s.sync = sync_stats_;
     }
+    s.drops += late_dropped(s.sync);
     static constexpr const char* kStates[] = {"waiting", "running", "done", "failed"};
     s.state = kStates[state_.load()];
     {

@@ -33,6 +33,12 @@ std::array<double, 2> LatencyWindow::percentiles_us() const {
   return {percentile(copy, 50) / 1000.0, percentile(copy, 95) / 1000.0};
 }
 
+std::uint64_t late_dropped(const SyncStats& sync) {
+  std::uint64_t dropped = 0;
+  for (const SyncInputStats& input : sync.inputs) dropped += input.late_dropped;
+  return dropped;
+}
+
 std::string format_sync_stats(const SyncStats& sync) {
   if (sync.inputs.empty()) return {};
   std::ostringstream out;

@@ -44,9 +44,14 @@ struct SyncStats {
 // One line: "joined 795 sets (790 complete), skew p50 1.2 ms p95 3.4 ms max 9.0 ms; people3d: 5
 // missing, 2 late; ..."; empty when not joined.
 std::string format_sync_stats(const SyncStats& sync);
+// Messages the synchroniser dropped for coming after their set (sync_late: drop), all inputs:
+// part of a node's drops, like those of its edges.
+std::uint64_t late_dropped(const SyncStats& sync);
 
 struct NodeStats {
   std::string node, type, process;
+  // drops: messages lost on its input edges, dropped by the node (Context::count_drop) or, late
+  // for their set, by its synchroniser (late_dropped).
   std::uint64_t in = 0, out = 0, drops = 0;
   double p50_us = 0, p95_us = 0;  // time spent in process(), over the last samples
   std::size_t queue_depth = 0, max_queue_depth = 0;

@@ -125,6 +125,23 @@ TEST(PeopleFitter, LiveModeKeepsItsLag) {
   }
   for (auto& f : fitter.finish()) out.push_back(std::move(f));
   expect_every_frame_once_in_order(in, out);
+  // Every frame timed once (fit::FrameTimes), its time in the summary the node reports.
+  EXPECT_EQ(fitter.frame_times().count(), in.size());
+  EXPECT_GT(fitter.frame_times().percentiles_ms()[1], 0.0);
+  EXPECT_NE(fitter.summary().find(", per frame p50 "), std::string::npos) << fitter.summary();
+}
+
+// Percentiles by nearest rank over the last kSamples frames; nothing before the first.
+TEST(FrameTimes, PercentilesOverTheLastFrames) {
+  fit::FrameTimes times;
+  EXPECT_EQ(times.describe("frame"), "");
+  for (int ms = 1; ms <= 100; ++ms) times.add(std::chrono::milliseconds(ms));
+  EXPECT_EQ(times.describe("frame"), "per frame p50 50.00 ms, p95 95.00 ms");
+  // Older frames leave the window: kSamples frames of 2 ms push all of the above out.
+  for (std::size_t i = 0; i < fit::FrameTimes::kSamples; ++i)
+    times.add(std::chrono::milliseconds(2));
+  EXPECT_EQ(times.describe("frame set"), "per frame set p50 2.00 ms, p95 2.00 ms");
+  EXPECT_EQ(times.count(), 100u + fit::FrameTimes::kSamples);
 }
 
 TEST(PeopleFitter, AStopFinishesWithinItsBudgetWithEveryFrame) {

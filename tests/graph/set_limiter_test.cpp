@@ -6,7 +6,9 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cstdio>
+#include <thread>
 
 #include "core/input_error.hpp"
 #include "graph/harness.hpp"
@@ -75,6 +77,56 @@ TEST(SetLimiter, NodeDropsWholeSetsWhileAnyStageIsBusy) {
   EXPECT_EQ(limit.stats().drops, 2u);  // the two frames of set 1
   EXPECT_EQ(limit.status(),
             "passed 2 of 3 sets (2 complete), 1 dropped while the stage was busy, 0 partial");
+}
+
+// Camera a's frame waits alone past sync_wait_ms and goes on as set 0; camera b's frame of that
+// instant then comes late. Returns the calls so far (1: set 0).
+std::size_t push_set_that_goes_on_without_b(Harness& node, const std::string& input) {
+  using namespace std::chrono_literals;
+  node.push(input, frame("a", 100, 7), 0);
+  std::size_t calls = node.process_ready();  // taken in: waits for b
+  std::this_thread::sleep_for(60ms);
+  calls += node.process_ready();             // its wait (30 ms) is over: on without b
+  node.push(input, frame("b", 102, 40), 1);  // late
+  node.push(input, frame("a", 133, 8), 0);
+  node.push(input, frame("b", 135, 41), 1);
+  return calls;
+}
+
+// A frame that comes after its set went on is counted late and dropped (the limiter's sync_late:
+// drop). Passed on as a set of its own it would take a set number, and every later set's time
+// (number x frame period) would be one period off.
+TEST(SetLimiter, AFrameLaterThanItsSetIsDroppedAndTheSetNumbersKeepTime) {
+  Harness limit("flow.set_limiter", {{"sync_wait_ms", "30"}},
+                {{{"frames", 2}}, {}, {}, AtBound::wait});
+  EXPECT_EQ(push_set_that_goes_on_without_b(limit, "frames"), 1u);
+  limit.finish();
+  const auto a = limit.pull<VideoFrame>("frames", 0), b = limit.pull<VideoFrame>("frames", 1);
+  ASSERT_EQ(a.size(), 2u);  // set 0 (b never seen yet: away) and set 1
+  ASSERT_EQ(b.size(), 1u);  // set 1 only
+  EXPECT_EQ(a[0]->header.frame, 0);
+  EXPECT_EQ(a[1]->header.frame, 1);
+  EXPECT_EQ(b[0]->header.frame, 1);
+  EXPECT_EQ(b[0]->header.capture_ns, 135'000'000);
+  const NodeStats stats = limit.stats();
+  EXPECT_EQ(stats.sync.inputs[1].late, 1u);
+  EXPECT_EQ(stats.sync.inputs[1].late_dropped, 1u);
+  EXPECT_EQ(stats.drops, 1u);
+  EXPECT_EQ(limit.status(),
+            "passed 2 of 2 sets (1 complete), 0 dropped while the stage was busy, 0 partial");
+}
+
+// sink.sets counts sets: a late frame is counted late and dropped, not counted as a set.
+TEST(SetsSink, AFrameLaterThanItsSetIsDroppedNotCountedAsASet) {
+  Harness sets("sink.sets", {{"sync_wait_ms", "30"}}, {{{"in", 2}}, {}, {}, AtBound::wait});
+  EXPECT_EQ(push_set_that_goes_on_without_b(sets, "in"), 1u);
+  sets.finish();
+  const NodeStats stats = sets.stats();
+  EXPECT_EQ(stats.sync.sets, 2u);
+  EXPECT_EQ(stats.sync.complete, 1u);
+  EXPECT_EQ(stats.sync.inputs[1].late, 1u);
+  EXPECT_EQ(stats.sync.inputs[1].late_dropped, 1u);
+  EXPECT_EQ(stats.drops, 1u);
 }
 
 TEST(SetLimiter, RepeatedOutputStreamsFollowTheInputsEdges) {

@@ -210,6 +210,8 @@ TEST(MultiViewNode, LiveFitGivesConstantBonesCloserToTheTruthOneOutputPerSetInOr
       EXPECT_NE(node.status().find("live fit: 76 of 76 person-frames fitted, 2 tracks"),
                 std::string::npos)
           << node.status();
+      // Its time per frame set (fit::FrameTimes, shared with the monocular fit).
+      EXPECT_NE(node.status().find(", per frame set p50 "), std::string::npos) << node.status();
     }
   }
   EXPECT_GT(results[0].worst_bone_std_m, 0.005);   // 4 px of noise: triangulated bones vary

@@ -7,6 +7,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -151,9 +152,43 @@ TEST(OverlaySink, ALagBeyondTheBoundIsCountedNotHung) {
   EXPECT_GT(late, 0u);
   EXPECT_EQ(stats.sync.inputs[1].missing, late);
   EXPECT_EQ(stats.sync.complete + late, 150u);
-  EXPECT_EQ(stats.drops, 2 * late);  // the 2D alone, then its 3D alone
+  EXPECT_EQ(stats.sync.inputs[1].late_dropped, late);  // sync_late: drop
+  EXPECT_EQ(stats.drops, 2 * late);  // the 2D undrawn, its 3D dropped by the synchroniser
   cv::Size size;
   EXPECT_EQ(count_video_frames(mp4, size), static_cast<int>(stats.sync.complete));
+}
+
+// A 3D that comes after its frame went on partial (here at the bound: 2D frames 0 and 1 against
+// a bound of 2) is counted late and dropped (the overlay's sync_late: drop), not passed on as a
+// frame of its own: one picture per frame, the sets counted are the frames.
+TEST(OverlaySink, A3DLaterThanItsFrameIsCountedAndDropped) {
+  test::TempDir dir;
+  graph::Harness overlay("sink.overlay",
+                         {{"png_every", "1"},
+                          {"png_dir", dir.file("png")},
+                          {"panel_height", "96"},
+                          {"sync_bound", "2"}},
+                         one_source());
+  overlay.push("people2d", people2d(0));
+  overlay.push("people2d", people2d(1));
+  EXPECT_EQ(overlay.process_ready(), 1u);  // frame 0 went on with its 2D alone
+  overlay.push("people3d", people3d(0));   // late
+  overlay.push("people3d", people3d(1));
+  EXPECT_EQ(overlay.process_ready(), 1u);  // frame 1, complete
+  overlay.push("people2d", people2d(2));
+  overlay.push("people3d", people3d(2));
+  overlay.finish();
+  std::vector<std::string> pngs;
+  for (const auto& entry : std::filesystem::directory_iterator(dir.file("png")))
+    pngs.push_back(entry.path().filename().string());
+  std::sort(pngs.begin(), pngs.end());
+  EXPECT_EQ(pngs, (std::vector<std::string>{"overlay_000001.png", "overlay_000002.png"}));
+  const graph::NodeStats stats = overlay.stats();
+  EXPECT_EQ(stats.sync.sets, 3u);
+  EXPECT_EQ(stats.sync.complete, 2u);
+  EXPECT_EQ(stats.sync.inputs[1].late, 1u);
+  EXPECT_EQ(stats.sync.inputs[1].late_dropped, 1u);
+  EXPECT_EQ(stats.drops, 2u);  // frame 0's 2D (undrawn) and its late 3D
 }
 
 // The video input, when connected, is drawn under the 2D people.

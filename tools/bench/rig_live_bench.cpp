@@ -9,7 +9,11 @@
 // --detector-ms D puts a stage of D ms per frame behind each camera (test.delay, a detector
 // slower than the cameras), fed as the live graphs feed detectors (a `latest` edge per camera),
 // or with --limit through flow.set_limiter (whole sets while every stage is idle, joined after
-// by the limiter's set numbers). A benchmark, not a test: it takes minutes.
+// by the limiter's set numbers). With --rtsp VIDEO the cameras are RTSP servers instead
+// (tests/support/rtsp_server.py, GStreamer's gst-rtsp-server: VIDEO looped as live H.264, one
+// server process per camera, each started once the one before listens, so their streams start
+// at unrelated instants: free-running network cameras), read by source.video; the killed one is
+// started again on its port. A benchmark, not a test: it takes minutes.
 
 #include <algorithm>
 #include <chrono>
@@ -27,6 +31,7 @@
 #include "graph/graph_spec.hpp"
 #include "graph/runtime.hpp"
 #include "graph/validation.hpp"
+#include "support/rtsp_server.hpp"
 
 namespace {
 
@@ -48,20 +53,29 @@ struct Settings {
   int width = 320, height = 240;
   double detector_ms = 0;  // a slow stage per camera; 0: none
   bool limit = false;      // the slow stages fed through flow.set_limiter
+  std::string rtsp_video;  // RTSP servers serving this video instead of fake GigE cameras
 };
 
 // The join after slow stages fed by the limiter: by its set numbers, waiting for a stage's output
 // (or a camera the limiter had no frame of) up to a second.
 constexpr double kJoinAfterLimiterWaitMs = 1000;
 
+// `serials`: the fake cameras' serials, or with --rtsp the servers' URLs.
 std::string graph_text(const Settings& s, const std::vector<std::string>& serials) {
   std::string text = "graph: rig_live_bench\nnodes:\n";
   char line[320];
   for (std::size_t i = 0; i < serials.size(); ++i) {
-    std::snprintf(line, sizeof line,
-                  "  cam%zu: { type: source.aravis, params: { id: %s, fps: %g, width: %d, height: "
-                  "%d, pixel_format: Mono8, camera: cam%zu } }\n",
-                  i + 1, serials[i].c_str(), s.fps, s.width, s.height, i + 1);
+    if (s.rtsp_video.empty()) {
+      std::snprintf(line, sizeof line,
+                    "  cam%zu: { type: source.aravis, params: { id: %s, fps: %g, width: %d, "
+                    "height: %d, pixel_format: Mono8, camera: cam%zu } }\n",
+                    i + 1, serials[i].c_str(), s.fps, s.width, s.height, i + 1);
+    } else {
+      std::snprintf(line, sizeof line,
+                    "  cam%zu: { type: source.video, params: { path: \"%s\", mode: live, "
+                    "camera: cam%zu } }\n",
+                    i + 1, serials[i].c_str(), i + 1);
+    }
     text += line;
   }
   for (std::size_t i = 0; s.detector_ms > 0 && i < serials.size(); ++i) {
@@ -107,8 +121,9 @@ struct Sample {
   std::uint64_t drops = 0;
   double rss = 0;
   std::string last_status;
-  std::string age;      // sink.sets' status: the sets' age when joined
-  std::string limiter;  // flow.set_limiter's status
+  std::string age;                // sink.sets' status: the sets' age when joined
+  std::string limiter;            // flow.set_limiter's status
+  graph::SyncStats limiter_sync;  // its join by capture time
 };
 
 // `watched`: the node whose status line is kept (the camera killed and restarted).
@@ -124,7 +139,10 @@ Sample sample(const graph::Runtime& runtime, double t, std::string event,
       s.sync = n.sync;
       s.age = n.status;
     }
-    if (n.node == "limit") s.limiter = n.status;
+    if (n.node == "limit") {
+      s.limiter = n.status;
+      s.limiter_sync = n.sync;
+    }
     if (n.node == watched) s.last_status = n.status;
   }
   return s;
@@ -151,15 +169,89 @@ void print_row(const Sample& s) {
   std::fflush(stdout);
 }
 
+// The cameras under test: fake GigE cameras (each its serial and loopback address) or RTSP
+// servers (each its process and port); the last one can be killed and started again as it was.
+class BenchCameras {
+ public:
+  explicit BenchCameras(const Settings& s) : settings_(s) {
+    if (s.rtsp_video.empty()) {
+      program_ = test::fake_camera_program();
+      if (!program_) {
+        problem_ = std::string(test::kFakeCameraProgram) + " not on PATH (package aravis-tools)";
+        return;
+      }
+    }
+    for (int i = 0; i < s.cameras && problem_.empty(); ++i) start(i, 0);
+  }
+  const std::string& problem() const { return problem_; }
+  // What the graph's sources open: the serials, or the servers' URLs.
+  const std::vector<std::string>& ids() const { return ids_; }
+  void kill_last() {
+    if (!fake_.empty()) fake_.back()->stop();
+    if (!rtsp_.empty()) rtsp_.back()->stop();
+  }
+  // On the same port (RTSP): the source reconnects to the URL it had.
+  void restart_last() {
+    const int last = settings_.cameras - 1;
+    const std::string& id = ids_.back();
+    start(last, settings_.rtsp_video.empty() ? 0 : std::stoi(id.substr(id.rfind(':') + 1)));
+  }
+
+ private:
+  void start(int i, int port) {
+    const bool again = static_cast<std::size_t>(i) < ids_.size();
+    if (settings_.rtsp_video.empty()) {
+      const std::string serial = "BENCH" + std::to_string(i + 1);
+      auto camera = std::make_unique<test::FakeGvCamera>(*program_, serial, 0, 15s,
+                                                         "127.0.0." + std::to_string(i + 1));
+      if (again) {
+        fake_.back() = std::move(camera);
+      } else {
+        fake_.push_back(std::move(camera));
+        ids_.push_back(serial);
+      }
+      return;
+    }
+    test::RtspServerOptions o;
+    o.video = settings_.rtsp_video;
+    o.width = settings_.width;
+    o.height = settings_.height;
+    o.frames = 150;  // decoded once and held: 5 s looped
+    o.fps = settings_.fps;
+    o.loop = true;
+    o.port = port;
+    auto server = std::make_unique<test::RtspServer>(dir_, "cam" + std::to_string(i + 1), o);
+    if (!server->problem().empty()) {
+      problem_ = server->problem();
+      return;
+    }
+    if (again) {
+      rtsp_.back() = std::move(server);
+    } else {
+      ids_.push_back(server->url());
+      rtsp_.push_back(std::move(server));
+    }
+  }
+
+  const Settings& settings_;
+  std::optional<std::string> program_;
+  test::TempDir dir_;  // the servers' output
+  std::vector<std::unique_ptr<test::FakeGvCamera>> fake_;
+  std::vector<std::unique_ptr<test::RtspServer>> rtsp_;
+  std::vector<std::string> ids_;
+  std::string problem_;
+};
+
 }  // namespace
 
 int main(int argc, char** argv) {
   // Before any thread starts (user namespaces require a single-threaded process).
   const std::string loopback = test::enter_private_loopback(8);
   cli::Args args("mocap-bench-rig-live [options]",
-                 "Fake GigE cameras joined by capture time for minutes; one killed and restarted.");
+                 "Fake GigE cameras (or RTSP servers) joined by capture time for minutes; one "
+                 "killed and restarted.");
   args.option("seconds", "S", "run length", "300", cli::Range::at_least(12))
-      .option("cameras", "N", "fake cameras (2..8)", "4", cli::Range::count(2, 8))
+      .option("cameras", "N", "cameras (2..8)", "4", cli::Range::count(2, 8))
       .option("fps", "F", "frame rate of every camera", "30", cli::Range::between(1, 120))
       .option("tolerance-ms", "MS", "sync_tolerance_ms", "10", cli::Range::positive())
       .option("wait-ms", "MS", "sync_wait_ms", "200", cli::Range::positive())
@@ -169,17 +261,15 @@ int main(int argc, char** argv) {
               cli::Range::between(0, 10000))
       .flag("limit",
             "feed the stages through flow.set_limiter (whole sets) instead of a "
-            "latest edge each");
+            "latest edge each")
+      .option("rtsp", "VIDEO",
+              "RTSP servers serving VIDEO (looped, live H.264, one process per camera; "
+              "tests/support/rtsp_server.py, run from the source folder) instead of fake GigE "
+              "cameras");
   int code = 0;
   if (!args.parse(argc - 1, argv + 1, code)) return code;
   if (!loopback.empty()) {
     std::cerr << "mocap-bench-rig-live: " << loopback << "\n";
-    return 1;
-  }
-  const auto program = test::fake_camera_program();
-  if (!program) {
-    std::cerr << "mocap-bench-rig-live: " << test::kFakeCameraProgram
-              << " not on PATH (package aravis-tools)\n";
     return 1;
   }
   Settings s;
@@ -191,18 +281,16 @@ int main(int argc, char** argv) {
   s.height = args.image_size("size").height;
   s.detector_ms = args.number("detector-ms");
   s.limit = args.has("limit");
+  if (args.has("rtsp")) s.rtsp_video = args.get("rtsp");
   const double seconds = args.number("seconds");
 
-  std::vector<std::string> serials;
-  std::vector<std::unique_ptr<test::FakeGvCamera>> cameras;
-  const auto address = [](int i) { return "127.0.0." + std::to_string(i + 1); };
-  for (int i = 0; i < s.cameras; ++i) {
-    serials.push_back("BENCH" + std::to_string(i + 1));
-    cameras.push_back(
-        std::make_unique<test::FakeGvCamera>(*program, serials.back(), 0, 15s, address(i)));
+  BenchCameras cameras(s);
+  if (!cameras.problem().empty()) {
+    std::cerr << "mocap-bench-rig-live: " << cameras.problem() << "\n";
+    return 1;
   }
   graph::Runtime runtime(
-      graph::resolve(graph::parse_graph_text(graph_text(s, serials), "rig_live_bench")));
+      graph::resolve(graph::parse_graph_text(graph_text(s, cameras.ids()), "rig_live_bench")));
   graph::RunResult result;
   const auto start = Clock::now();
   std::thread run([&] { result = runtime.run(); });
@@ -212,11 +300,13 @@ int main(int argc, char** argv) {
   if (s.detector_ms > 0)
     std::snprintf(stage, sizeof stage, "a %g ms stage per camera %s", s.detector_ms,
                   s.limit ? "behind flow.set_limiter" : "on a latest edge");
+  const std::string kind =
+      s.rtsp_video.empty() ? "fake GigE cameras" : "RTSP servers (" + s.rtsp_video + ", H.264)";
   std::printf(
-      "%d fake cameras at %g fps (%dx%d Mono8), sync_tolerance_ms %g, sync_wait_ms %g, "
-      "%g s; cam%d killed at %.0f s, restarted at %.0f s; %s\n\n",
-      s.cameras, s.fps, s.width, s.height, s.tolerance_ms, s.wait_ms, seconds, s.cameras,
-      seconds / 3, seconds / 2, stage);
+      "%d %s at %g fps (%dx%d), sync_tolerance_ms %g, sync_wait_ms %g, %g s; cam%d killed at "
+      "%.0f s, restarted at %.0f s; %s\n\n",
+      s.cameras, kind.c_str(), s.fps, s.width, s.height, s.tolerance_ms, s.wait_ms, seconds,
+      s.cameras, seconds / 3, seconds / 2, stage);
   print_header(s.cameras);
   std::vector<Sample> samples;
   const std::string watched = "cam" + std::to_string(s.cameras);
@@ -230,14 +320,13 @@ int main(int argc, char** argv) {
     if (!killed && t >= kill_at) {
       samples.push_back(sample(runtime, t, "before kill", watched));
       print_row(samples.back());
-      cameras.back()->stop();
+      cameras.kill_last();
       killed = true;
       event = "cam" + std::to_string(s.cameras) + " killed";
     } else if (!restarted && t >= restart_at) {
       samples.push_back(sample(runtime, t, "before restart", watched));
       print_row(samples.back());
-      cameras.back() = std::make_unique<test::FakeGvCamera>(*program, serials.back(), 0, 15s,
-                                                            address(s.cameras - 1));
+      cameras.restart_last();
       restarted = true;
       event = "cam" + std::to_string(s.cameras) + " restarted";
     } else if (t < next_sample) {
@@ -306,6 +395,9 @@ int main(int argc, char** argv) {
               result.ok ? "ok" : result.error.c_str());
   std::cout << graph::format_sync_stats(end.sync) << "\n";
   std::printf("sets' %s\n", end.age.c_str());
-  if (s.limit) std::printf("limiter: %s\n", end.limiter.c_str());
+  if (s.limit) {
+    std::printf("limiter: %s\n", end.limiter.c_str());
+    std::cout << "limiter's join: " << graph::format_sync_stats(end.limiter_sync) << "\n";
+  }
   return result.ok ? 0 : 1;
 }

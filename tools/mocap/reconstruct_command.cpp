@@ -447,6 +447,8 @@ json node_latency(const graph::GraphStats& stats) {
   for (const auto& n : stats.nodes) {
     nodes[n.node] = {{"type", n.type},   {"in", n.in},         {"out", n.out},
                      {"drops", n.drops}, {"p50_us", n.p50_us}, {"p95_us", n.p95_us}};
+    // Its last status line (the fits: what was fitted and the time per frame or frame set).
+    if (!n.status.empty()) nodes[n.node]["status"] = n.status;
     if (n.sync.inputs.empty()) continue;
     // A joined node: its sets, and the messages that came after their set went on.
     std::uint64_t late = 0, late_dropped = 0;

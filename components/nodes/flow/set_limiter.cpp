@@ -22,7 +22,10 @@ class SetLimiterNode : public Node {
         "is idle, drops them whole while it is busy (numbered as frames)");
     c.inputs<VideoFrame>("frames", "one camera's frames", 1, 64);
     c.outputs<VideoFrame>("frames", "that camera's frames of the sets passed on", "frames");
-    c.join({{"frames"}, SyncKey::capture_time, 64, 10.0, 200.0});
+    // A frame that comes after its set went on (sync_wait_ms) is dropped, not passed as a set of
+    // its own: that set would take a number (shifting the time of every later set) and, alone,
+    // keep its camera from counting as away, so that the others' sets would be dropped as partial.
+    c.join({{"frames"}, SyncKey::capture_time, 64, 10.0, 200.0, LateMessages::drop});
   }
 
   void open(Context& ctx) override {

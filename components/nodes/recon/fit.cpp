@@ -87,12 +87,15 @@ class FitNode : public Node {
     if (!fitter_) return ctx.forward("out", "in");
     if (ctx.stop_requested()) fitter_->stop();  // the drain: no long solve from now on
     send(ctx, fitter_->push(ctx.input<People3D>("in")));
+    // The statistics' status column: what is fitted and the time per frame (fit::FrameTimes).
+    if (fitter_->frame_times().count() % 30 == 1) ctx.report_status(fitter_->summary());
   }
 
   void close(Context& ctx) override {
     if (!fitter_) return;
     if (ctx.stop_requested()) fitter_->stop();
     send(ctx, fitter_->finish());
+    ctx.report_status(fitter_->summary());
     std::cerr << "recon.fit '" << ctx.node_name() << "': " << fitter_->summary() << "\n";
   }
 

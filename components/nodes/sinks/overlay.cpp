@@ -45,8 +45,10 @@ class OverlaySink : public Node {
     c.param<double>("view_yaw_deg", 35.0, "3D view: turn about the vertical", {-180.0, 180.0});
     c.param<double>("view_pitch_deg", 30.0, "3D view: looking down by", {-89.0, 89.0});
     // The 3D of a frame comes after its 2D by the lag of the stages between (the offline fit
-    // works in windows of 64 frames per person): held up to sync_bound frames per input.
-    c.join({{"people2d", "people3d", "video"}, SyncKey::frame, 256});
+    // works in windows of 64 frames per person): held up to sync_bound frames per input. A message
+    // that comes after its frame went on partial cannot be drawn (its partner went with the
+    // frame): counted and dropped (sync_late) rather than passed on as a frame of its own.
+    c.join({{"people2d", "people3d", "video"}, SyncKey::frame, 256, 0.0, 0.0, LateMessages::drop});
   }
 
   void open(Context& ctx) override {
