@@ -49,7 +49,7 @@ double rss_mib() {
 
 struct Settings {
   int cameras = 4;
-  double fps = 30, tolerance_ms = 10, wait_ms = 200;
+  double fps = 30, tolerance_ms = 20, wait_ms = 200;
   int width = 320, height = 240;
   double detector_ms = 0;  // a slow stage per camera; 0: none
   bool limit = false;      // the slow stages fed through flow.set_limiter
@@ -253,7 +253,7 @@ int main(int argc, char** argv) {
   args.option("seconds", "S", "run length", "300", cli::Range::at_least(12))
       .option("cameras", "N", "cameras (2..8)", "4", cli::Range::count(2, 8))
       .option("fps", "F", "frame rate of every camera", "30", cli::Range::between(1, 120))
-      .option("tolerance-ms", "MS", "sync_tolerance_ms", "10", cli::Range::positive())
+      .option("tolerance-ms", "MS", "sync_tolerance_ms", "20", cli::Range::positive())
       .option("wait-ms", "MS", "sync_wait_ms", "200", cli::Range::positive())
       .option("size", "WxH", "frame size", "320x240", cli::Range::image_size())
       .option("detector-ms", "MS",

@@ -328,8 +328,11 @@ std::string live_graph_part(const std::vector<View>& views, double fps, const st
           << "  - [limit.frames:" << i << ", detect_" << i << ".in]\n"
           << "  - [detect_" << i << ".out, solve.view:" << i << "]\n";
   }
-  // Under half a frame period, or two frames of one camera could fall into one set.
-  const double tolerance_ms = 0.4 * 1000.0 / fps;
+  // Over half a frame period: free-running cameras' frames are up to half a period apart, and a
+  // shorter tolerance splits each instant into two partial sets at an unlucky phase
+  // (docs/cameras.md, "Free-running RTSP cameras"); under a period, so a set never reaches a
+  // camera's next frame. Triggered cameras are within a millisecond either way.
+  const double tolerance_ms = 0.6 * 1000.0 / fps;
   g << "  limit: { type: flow.set_limiter, params: { sync_tolerance_ms: "
     << json(tolerance_ms).dump() << ", sync_wait_ms: " << kLiveSyncWaitMs << " } }\n";
   return g.str();

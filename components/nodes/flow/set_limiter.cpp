@@ -25,7 +25,10 @@ class SetLimiterNode : public Node {
     // A frame that comes after its set went on (sync_wait_ms) is dropped, not passed as a set of
     // its own: that set would take a number (shifting the time of every later set) and, alone,
     // keep its camera from counting as away, so that the others' sets would be dropped as partial.
-    c.join({{"frames"}, SyncKey::capture_time, 64, 10.0, 200.0, LateMessages::drop});
+    // 20 ms: 0.6 of a 30 fps period. Free-running cameras' frames are up to half a period apart,
+    // so a shorter tolerance splits every instant at an unlucky phase (docs/cameras.md,
+    // "Free-running RTSP cameras"); under a period, a set never reaches a camera's next frame.
+    c.join({{"frames"}, SyncKey::capture_time, 64, 20.0, 200.0, LateMessages::drop});
   }
 
   void open(Context& ctx) override {

@@ -18,9 +18,10 @@ class SetsSink : public Node {
   static void contract(Contract& c) {
     c.doc("Joins its inputs into sets and discards them; the sets are counted in the statistics");
     c.inputs_any("in", "a stream to join (any type): one per camera", 1, 64);
-    // 30 fps: a third of a frame period; a stalled camera holds the others back 200 ms at most.
+    // 20 ms, as flow.set_limiter's: 0.6 of a 30 fps period, so free-running cameras join at any
+    // phase; a stalled camera holds the others back 200 ms at most.
     // A late message is counted and dropped: passed alone it would count as a set of its own.
-    c.join({{"in"}, SyncKey::capture_time, 64, 10.0, 200.0, LateMessages::drop});
+    c.join({{"in"}, SyncKey::capture_time, 64, 20.0, 200.0, LateMessages::drop});
   }
   void process(Context& ctx) override {
     std::int64_t oldest = 0;
