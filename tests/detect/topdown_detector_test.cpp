@@ -351,6 +351,35 @@ TEST(TopDownDetector, NewcomersWhosePoseDisagreesWithTheirBoxAreNotPeople) {
   EXPECT_THROW(TopDownDetector(o, m->lightning, m->centernet), std::invalid_argument);
 }
 
+// The rules for people followed as one box (one_box_per_followed, duplicate_similarity) and
+// CenterNet at the frame's aspect only add people on frame 300's walkers, who stand apart: each
+// person found without them is found with them, on a detector run and a followed frame.
+TEST(TopDownDetector, TheRulesForPeopleAsOneBoxKeepThePeopleFoundApart) {
+  std::string why;
+  const auto m = models(why);
+  if (!m) GTEST_SKIP() << why;
+  TopDownOptions o;
+  o.detect_every = 2;
+  const Frames plain = run(*m, o, 2);
+  o.one_box_per_followed = true;
+  o.duplicate_similarity = 0.9f;
+  o.detector_aspect = true;
+  const Frames ruled = run(*m, o, 2);
+  ASSERT_EQ(plain.people.size(), ruled.people.size());
+  for (std::size_t f = 0; f < plain.people.size(); ++f) {
+    SCOPED_TRACE(f);
+    EXPECT_GE(plain.people[f].size(), 3u);
+    for (const MovenetPerson& p : plain.people[f]) {
+      const bool again =
+          std::any_of(ruled.people[f].begin(), ruled.people[f].end(),
+                      [&](const MovenetPerson& q) { return iou(p.box, q.box) > 0.5f; });
+      EXPECT_TRUE(again) << "the person at x " << p.box.x << " lost";
+    }
+  }
+  o.duplicate_similarity = 1.5f;
+  EXPECT_THROW(TopDownDetector(o, m->lightning, m->centernet), std::invalid_argument);
+}
+
 // Frames 0..5 of the moving picture with the keypoint network every frame, then every third.
 TEST(TopDownDetector, KeypointsCarriedByFlowStayWithTheNetworksBetweenPasses) {
   std::string why;
