@@ -324,6 +324,7 @@ void TopDownDetector::people_found(const ImageBuffer& frame, std::vector<Found>&
     }
     const CropVerdict verdict = judge_crop(found_[i], options_);
     person.score = verdict.score;
+    if (split_[i]) continue;  // split into the detector's boxes (split_followed)
     const float box_score = box_scores_[i];
     const bool agrees = options_.newcomer_agreement <= 0 || !newcomer_[i] ||
                         iou(posed_box(found_[i], r, options_, frame.width(), frame.height()),
@@ -401,7 +402,8 @@ void TopDownDetector::record_crops(const std::vector<Found>& found,
   using Fate = TopDownTrace::Fate;
   trace_.crops.assign(crop_boxes_.size(), {});
   for (std::size_t i = 0; i < crop_boxes_.size(); ++i)
-    trace_.crops[i] = {crop_boxes_[i], newcomer_[i] != 0, {}, Fate::rejected};
+    trace_.crops[i] = {
+        crop_boxes_[i], newcomer_[i] != 0, {}, split_[i] ? Fate::split : Fate::rejected};
   for (std::size_t f = 0; f < found.size(); ++f) {
     if (found[f].crop < 0) continue;
     TopDownTrace::Crop& c = trace_.crops[static_cast<std::size_t>(found[f].crop)];
@@ -426,11 +428,13 @@ std::vector<MovenetPerson> TopDownDetector::detect(const ImageBuffer& frame) {
   std::vector<Box2D> boxes;
   box_scores_.clear();
   newcomer_.clear();
+  split_.clear();
   for (std::size_t i = 0; i < followed_.size(); ++i) {
     if (carried_[i]) continue;
     boxes.push_back(moved(followed_[i].box, followed_[i].vx, followed_[i].vy));
     box_scores_.push_back(followed_[i].box_score);
     newcomer_.push_back(0);
+    split_.push_back(0);
   }
   const bool run_detector =
       frame_ % options_.detect_every == 0 || lost_someone_ || followed_.empty();
@@ -467,9 +471,22 @@ std::vector<MovenetPerson> TopDownDetector::detect(const ImageBuffer& frame) {
       profile_.centernet_wait += seconds_since(running);
     }
     const std::size_t followed = boxes.size();
-    const std::vector<int> owner =
-        followed_boxes(std::span<const Box2D>(boxes).first(followed), detections,
-                       options_.followed_overlap, options_.one_box_per_followed);
+    if (options_.split_followed) {
+      // A followed box over two detector boxes or more is that many people: their crop is set
+      // aside (its box empty, overlapping nothing) and each box becomes a newcomer.
+      for (std::size_t i = 0; i < followed; ++i) {
+        const auto over = std::count_if(detections.begin(), detections.end(), [&](const auto& d) {
+          return iou(boxes[i], d.box) > options_.followed_overlap;
+        });
+        if (over >= 2) split_[i] = 1;
+      }
+    }
+    std::vector<Box2D> claimants(boxes.begin(),
+                                 boxes.begin() + static_cast<std::ptrdiff_t>(followed));
+    for (std::size_t i = 0; i < followed; ++i)
+      if (split_[i]) claimants[i] = {};
+    const std::vector<int> owner = followed_boxes(claimants, detections, options_.followed_overlap,
+                                                  options_.one_box_per_followed);
     // A followed person's detector score is the best of the boxes that are them (0: none): with
     // one_box_per_followed their own box's, else that of every box overlapping them.
     for (std::size_t i = 0; i < followed; ++i) {
@@ -477,7 +494,7 @@ std::vector<MovenetPerson> TopDownDetector::detect(const ImageBuffer& frame) {
       for (std::size_t d = 0; d < detections.size(); ++d)
         if (options_.one_box_per_followed
                 ? owner[d] == static_cast<int>(i)
-                : iou(boxes[i], detections[d].box) > options_.followed_overlap)
+                : iou(claimants[i], detections[d].box) > options_.followed_overlap)
           box_scores_[i] = std::max(box_scores_[i], detections[d].score);
     }
     trace_.detections = detections;
@@ -491,6 +508,7 @@ std::vector<MovenetPerson> TopDownDetector::detect(const ImageBuffer& frame) {
         boxes.push_back(box);
         box_scores_.push_back(detections[d].score);
         newcomer_.push_back(1);
+        split_.push_back(0);
       }
     }
   }

@@ -59,6 +59,10 @@ struct TopDownOptions {
   // that one of two people embracing or crossing, followed as one box, is looked for. Off: every
   // box overlapping a followed person's is that person.
   bool one_box_per_followed = false;
+  // On a detector run, a followed person whose box overlaps two or more detector boxes (each by
+  // more than followed_overlap) is that many people: two people embracing or crossing whom one
+  // crop's landmarks span as one box. Their crop is set aside and each box gets its own crop.
+  bool split_followed = false;
   float crop_padding = 1.25f;  // crop side = longer box side × this
   // A box shorter than small_box_height px (0: none) gets a crop of side longer box side ×
   // small_crop_padding instead: more context around a small person, whose detector box is
@@ -183,11 +187,12 @@ inline constexpr float kHeadAboveEyesPerEyeToShoulder = 0.54f;
 // --diagnose: which rule dropped a person the detector had proposed).
 struct TopDownTrace {
   enum class Fate : std::uint8_t {
-    rejected,             // the crop's keypoints failed the person test
-    kept,                 // a person of the frame
-    duplicate_box,        // dropped: box overlap with a kept person (duplicate_overlap)
-    duplicate_keypoints,  // dropped: most keypoints on a kept person's
-    duplicate_similarity  // dropped: keypoint similarity (duplicate_similarity)
+    rejected,              // the crop's keypoints failed the person test
+    kept,                  // a person of the frame
+    duplicate_box,         // dropped: box overlap with a kept person (duplicate_overlap)
+    duplicate_keypoints,   // dropped: most keypoints on a kept person's
+    duplicate_similarity,  // dropped: keypoint similarity (duplicate_similarity)
+    split                  // set aside: a followed box over several detector boxes
   };
   struct Crop {
     Box2D box;              // the box it was cut around
@@ -287,6 +292,7 @@ class TopDownDetector {
   std::vector<Box2D> crop_boxes_;       // per crop of the frame: the box it was cut around
   std::vector<float> box_scores_;       // per box of the frame: the detector's score of it
   std::vector<std::uint8_t> newcomer_;  // per box of the frame: a detector box nobody followed
+  std::vector<std::uint8_t> split_;     // per box: a followed box split (split_followed)
   std::vector<SinglePose> found_;
   std::vector<Followed> followed_;
   std::unique_ptr<KeypointFlow> flow_;  // with keypoint_every > 1

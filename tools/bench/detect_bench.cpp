@@ -103,7 +103,7 @@ Strategy make_strategy(const std::string& spec, detect::Backend backend, int thr
     } catch (const std::invalid_argument&) {
       throw std::invalid_argument(
           "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:kEVERY][:uSURE][:"
-          "bPRESENCE][:m0][:h1][:cH[xP]][:aIOU][:oOKS][:n1][:r1] with "
+          "bPRESENCE][:m0][:h1][:cH[xP]][:aIOU][:oOKS][:n1][:x1][:r1] with "
           "MODEL " +
           std::string(detect::pose_model_names()) + ", got " + spec);
     }
@@ -132,6 +132,8 @@ Strategy make_strategy(const std::string& spec, detect::Backend backend, int thr
         o.duplicate_similarity = std::stof(parts[i].substr(1));
       else if (parts[i] == "n1")
         o.one_box_per_followed = true;
+      else if (parts[i] == "x1")
+        o.split_followed = true;
       else if (parts[i] == "r1")
         o.detector_aspect = true;
       else if (parts[i] == "h1")
@@ -149,7 +151,7 @@ Strategy make_strategy(const std::string& spec, detect::Backend backend, int thr
     if (numbers.size() > 2)
       throw std::invalid_argument(
           "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:kEVERY][:uSURE][:"
-          "bPRESENCE][:m0][:h1][:cH[xP]][:aIOU][:oOKS][:n1][:r1], got " +
+          "bPRESENCE][:m0][:h1][:cH[xP]][:aIOU][:oOKS][:n1][:x1][:r1], got " +
           spec);
     o.backend = backend;
     o.threads = numbers.size() == 2 ? std::stoi(numbers[1]) : threads;
@@ -169,7 +171,7 @@ Strategy make_strategy(const std::string& spec, detect::Backend backend, int thr
       "unknown strategy '" + spec +
       "' (multipose:SIZE, tiles:CxR:TILE:FRAME, "
       "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:"
-      "kEVERY][:uSURE][:bPRESENCE][:m0][:h1][:cH[xP]][:aIOU][:oOKS][:n1][:r1])");
+      "kEVERY][:uSURE][:bPRESENCE][:m0][:h1][:cH[xP]][:aIOU][:oOKS][:n1][:x1][:r1])");
 }
 
 // Every frame of a video, or the one image of a still.
@@ -365,6 +367,8 @@ std::string dropped_by(const detect::TopDownTrace& t, const Box2D& truth) {
         return "dropped as duplicate: same keypoints";
       case Fate::duplicate_similarity:
         return "dropped as duplicate: keypoint similarity";
+      case Fate::split:
+        return "set aside (split into the detector's boxes)";
     }
     return "?";
   };
@@ -642,7 +646,7 @@ int main(int argc, char** argv) {
           "multipose:SIZE, "
           "tiles:CxR:TILE:FRAME, "
           "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:kEVERY][:"
-          "uSURE][:bPRESENCE][:m0][:h1][:cH[xP]][:aIOU][:oOKS][:n1][:r1] "
+          "uSURE][:bPRESENCE][:m0][:h1][:cH[xP]][:aIOU][:oOKS][:n1][:x1][:r1] "
           "(MODEL: lightning, thunder, blazepose-lite, blazepose-full, blazepose-heavy; "
           "workers: copies of the keypoint network sharing a frame's crops; tTILES: person "
           "detector tiles, tTILESw: and the whole frame, sSCORE: its box score floor, uSURE: "
@@ -655,6 +659,7 @@ int main(int argc, char** argv) {
           "the detector's by this IoU, oOKS: finds sharing 3 keypoints are one person only at this "
           "keypoint similarity (COCO OKS; 0.9: HRNet's), n1: a followed person is at most one "
           "detector box (others overlapping them get crops), "
+          "x1: a followed box over 2+ detector boxes is split into them, "
           "r1: CenterNet sees the frame at its aspect "
           "(512 x 896 for 16:9) instead of squeezed to 512 x 512, kEVERY: keypoint pass every "
           "EVERY "

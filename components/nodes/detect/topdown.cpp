@@ -46,6 +46,9 @@ class TopDownNode : public Node {
     c.param<bool>("one_box_per_followed", false,
                   "on a detector run a followed person is at most one box; another box "
                   "overlapping them gets its own crop (two people followed as one box)");
+    c.param<bool>("split_followed", false,
+                  "on a detector run a followed person whose box overlaps two detector boxes or "
+                  "more is that many people, each cropped from their box");
     c.param<double>("duplicate_similarity", 0.0,
                     "two finds sharing 3 keypoints are one person only at this keypoint "
                     "similarity (COCO OKS; 0.9: HRNet's), whatever their boxes' overlap; 0: "
@@ -99,6 +102,7 @@ class TopDownNode : public Node {
     o.detector_whole_frame = ctx.param<bool>("detector_whole_frame");
     o.detector_aspect = ctx.param<bool>("detector_aspect");
     o.one_box_per_followed = ctx.param<bool>("one_box_per_followed");
+    o.split_followed = ctx.param<bool>("split_followed");
     o.duplicate_similarity = ctx.param<float>("duplicate_similarity");
     o.sure_box_score = ctx.param<float>("sure_box_score");
     o.min_person_score = ctx.param<float>("min_person_score");
