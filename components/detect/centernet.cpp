@@ -5,6 +5,9 @@
 #include <stdexcept>
 #include <string>
 
+#include "detect/model_files.hpp"
+#include "detect/tfjs_model.hpp"
+
 namespace mocap::detect {
 namespace {
 
@@ -81,14 +84,37 @@ CenternetNetwork::CenternetNetwork(const std::filesystem::path& model_json,
                                    const RunnerOptions& options)
     : runner_(make_graph_runner(model_json, kHeads, options)) {}
 
+CenternetNetwork::CenternetNetwork(const std::filesystem::path& model_json, int height, int width,
+                                   const RunnerOptions& options)
+    : height_(height), width_(width) {
+  constexpr int kGraphStride = 32;  // MobileNetV3's deepest feature map: 1/32 of the input
+  if (height < kGraphStride || width < kGraphStride || height % kGraphStride != 0 ||
+      width % kGraphStride != 0)
+    throw std::invalid_argument("CenterNet's input sides must be multiples of 32, got " +
+                                std::to_string(height) + " x " + std::to_string(width));
+  if (height == kCenternetInput && width == kCenternetInput) {
+    runner_ = make_graph_runner(model_json, kHeads, options);
+    return;
+  }
+  try {
+    runner_ = make_graph_runner(std::make_shared<const TfjsModel>(tfjs_with_input_size(
+                                    read_tfjs_model(model_json), height, width)),
+                                kHeads, options);
+  } catch (const ModelError& e) {
+    throw ModelError(std::string(e.what()) + "; if the file is damaged or not this model, " +
+                     kFetchModelsHint);
+  }
+}
+
 const std::vector<GraphTensor>& CenternetNetwork::run(const GraphTensor& image) {
-  if (image.shape != std::vector<std::int64_t>{1, kCenternetInput, kCenternetInput, 3} ||
+  if (image.shape != std::vector<std::int64_t>{1, height_, width_, 3} ||
       image.values.size() != image.size())
-    throw std::invalid_argument("CenterNet takes one 512 x 512 x 3 image");
+    throw std::invalid_argument("CenterNet takes one " + std::to_string(height_) + " x " +
+                                std::to_string(width_) + " x 3 image");
   runner_->run({image.shape, image.values}, heads_);
-  const int grid = kCenternetInput / kStride;
   if (heads_.size() != 2 || heads_[0].shape.size() != 4 || heads_[1].shape.size() != 4 ||
-      heads_[0].shape[1] != grid || heads_[0].shape[2] != grid || heads_[1].shape[3] != 4)
+      heads_[0].shape[1] != height_ / kStride || heads_[0].shape[2] != width_ / kStride ||
+      heads_[1].shape[3] != 4)
     throw std::runtime_error(
         "CenterNet: heads of an unexpected shape (is the model file the right one?)");
   return heads_;

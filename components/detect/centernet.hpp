@@ -41,13 +41,21 @@ class CenternetNetwork {
   // Throws std::runtime_error (naming the file and the fetch command) when it cannot be loaded.
   explicit CenternetNetwork(const std::filesystem::path& model_json,
                             const RunnerOptions& options = {});
+  // The same network fed a height × width image (the graph is fully convolutional; its frozen
+  // upsampling sizes are scaled, tfjs_with_input_size): both multiples of 32 (its stride),
+  // e.g. 512 × 896 for a 16:9 frame at its own aspect. Throws std::invalid_argument otherwise.
+  CenternetNetwork(const std::filesystem::path& model_json, int height, int width,
+                   const RunnerOptions& options = {});
 
-  // Heatmap and sides for one NHWC float RGB 0..255 image [1, kCenternetInput, kCenternetInput,
+  // Heatmap and sides for one NHWC float RGB 0..255 image [1, input_height(), input_width(),
   // 3]; valid until the next call.
   const std::vector<GraphTensor>& run(const GraphTensor& image);
   Backend backend() const { return runner_->backend(); }
+  int input_height() const { return height_; }
+  int input_width() const { return width_; }
 
  private:
+  int height_ = kCenternetInput, width_ = kCenternetInput;
   std::unique_ptr<GraphRunner> runner_;
   std::vector<GraphTensor> heads_;  // reused from call to call
 };

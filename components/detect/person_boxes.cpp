@@ -67,21 +67,62 @@ Box2D clip_box(const Box2D& box, float width, float height) {
   return {x0, y0, x1 - x0, y1 - y0};
 }
 
-std::vector<std::size_t> distinct_people(std::span<const MovenetPerson> people, float max_iou,
-                                         float near) {
+float keypoint_similarity(const MovenetPerson& kept, const MovenetPerson& other, int& common) {
+  // COCO's keypoint σ (cocoeval.py), nose, eyes, ears, shoulders, elbows, wrists, hips, knees,
+  // ankles; κ = 2σ.
+  constexpr std::array<float, kMovenetKeypoints> kSigma = {
+      0.026f, 0.025f, 0.025f, 0.035f, 0.035f, 0.079f, 0.079f, 0.072f, 0.072f,
+      0.062f, 0.062f, 0.107f, 0.107f, 0.087f, 0.087f, 0.089f, 0.089f};
+  const float area = std::max(kept.box.width * kept.box.height, 1.0f);
+  common = 0;
+  float sum = 0;
+  for (int k = 0; k < kMovenetKeypoints; ++k) {
+    const Keypoint2D &a = kept.keypoints[k], &b = other.keypoints[k];
+    if (!present(a) || !present(b)) continue;
+    ++common;
+    const float kappa = 2 * kSigma[static_cast<std::size_t>(k)];
+    const float d2 = (a.x - b.x) * (a.x - b.x) + (a.y - b.y) * (a.y - b.y);
+    sum += std::exp(-d2 / (2 * area * kappa * kappa));
+  }
+  return common > 0 ? sum / static_cast<float>(common) : 0.0f;
+}
+
+std::vector<std::size_t> distinct_people(std::span<const MovenetPerson> people,
+                                         const DuplicateTest& test,
+                                         std::vector<DuplicateRule>* why) {
   std::vector<std::size_t> order(people.size());
   for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
   std::stable_sort(order.begin(), order.end(),
                    [&](std::size_t a, std::size_t b) { return people[a].score > people[b].score; });
+  const auto rule = [&](const MovenetPerson& kept, const MovenetPerson& other) {
+    if (test.min_similarity > 0) {
+      int common = 0;
+      const float similarity = keypoint_similarity(kept, other, common);
+      if (common >= 3)
+        return similarity >= test.min_similarity ? DuplicateRule::keypoint_similarity
+                                                 : DuplicateRule::none;
+      return iou(kept.box, other.box) > test.max_iou ? DuplicateRule::box_overlap
+                                                     : DuplicateRule::none;
+    }
+    if (iou(kept.box, other.box) > test.max_iou) return DuplicateRule::box_overlap;
+    return same_keypoints(kept, other, test.near) ? DuplicateRule::same_keypoints
+                                                  : DuplicateRule::none;
+  };
+  if (why) why->assign(people.size(), DuplicateRule::none);
   std::vector<std::size_t> kept;
   for (const std::size_t i : order) {
-    const bool duplicate = std::any_of(kept.begin(), kept.end(), [&](std::size_t k) {
-      return iou(people[k].box, people[i].box) > max_iou ||
-             same_keypoints(people[k], people[i], near);
-    });
-    if (!duplicate) kept.push_back(i);
+    DuplicateRule dropped = DuplicateRule::none;
+    for (const std::size_t k : kept)
+      if ((dropped = rule(people[k], people[i])) != DuplicateRule::none) break;
+    if (dropped == DuplicateRule::none) kept.push_back(i);
+    if (why) (*why)[i] = dropped;
   }
   return kept;
+}
+
+std::vector<std::size_t> distinct_people(std::span<const MovenetPerson> people, float max_iou,
+                                         float near) {
+  return distinct_people(people, DuplicateTest{max_iou, near, 0.0f});
 }
 
 std::vector<MovenetPerson> remove_duplicates(std::vector<MovenetPerson> people, float max_iou,

@@ -1,6 +1,7 @@
 #include "detect/person_proposals.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 
 #include "detect/image_tensor.hpp"
@@ -23,6 +24,18 @@ std::vector<SquareRegion> proposal_tiles(int width, int height, int tiles, bool 
   return out;
 }
 
+std::pair<int, int> centernet_input_at_aspect(int width, int height) {
+  constexpr int kStride = 32;
+  const int short_side = std::min(width, height), long_side = std::max(width, height);
+  const int scaled = short_side > 0
+                         ? static_cast<int>(std::lround(static_cast<double>(long_side) *
+                                                        kCenternetInput / short_side / kStride)) *
+                               kStride
+                         : kCenternetInput;
+  const int other = std::max(kCenternetInput, scaled);
+  return width >= height ? std::pair{kCenternetInput, other} : std::pair{other, kCenternetInput};
+}
+
 std::vector<Detection> propose_people(CenternetNetwork& network, const ImageBuffer& frame,
                                       const ProposalOptions& options, GraphTensor& input) {
   const std::vector<SquareRegion> tiles =
@@ -31,7 +44,9 @@ std::vector<Detection> propose_people(CenternetNetwork& network, const ImageBuff
   std::vector<Detection> all;
   for (std::size_t t = 0; t < tiles.size(); ++t) {
     const SquareRegion& r = tiles[t];
-    image_batch(input, 1, kCenternetInput, kCenternetInput);
+    if (r.side != 0 && network.input_height() != network.input_width())
+      throw std::invalid_argument("person detector tiles need a square network input");
+    image_batch(input, 1, network.input_height(), network.input_width());
     if (r.side == 0) {
       fill_stretched(frame, input, 0);
     } else {
@@ -50,9 +65,9 @@ std::vector<Detection> propose_people(CenternetNetwork& network, const ImageBuff
     const bool has_next = r.side != 0 && t + 1 < tiles.size() && tiles[t + 1].side != 0;
     const float low = has_previous ? (centre + tile_centre(t - 1)) / 2 : -1e9f;
     const float high = has_next ? (centre + tile_centre(t + 1)) / 2 : 1e9f;
-    const float sx = r.side == 0 ? static_cast<float>(frame.width()) / kCenternetInput
+    const float sx = r.side == 0 ? static_cast<float>(frame.width()) / network.input_width()
                                  : r.side / kCenternetInput;
-    const float sy = r.side == 0 ? static_cast<float>(frame.height()) / kCenternetInput
+    const float sy = r.side == 0 ? static_cast<float>(frame.height()) / network.input_height()
                                  : r.side / kCenternetInput;
     const float x0 = r.side == 0 ? 0 : r.cx - r.side / 2, y0 = r.side == 0 ? 0 : r.cy - r.side / 2;
     for (Detection& d : found) {

@@ -8,6 +8,7 @@
 // `whole_frame` adds one pass over the whole frame stretched, which sees them whole. The
 // detections of all passes are then thinned by NMS.
 
+#include <utility>
 #include <vector>
 
 #include "core/image_buffer.hpp"
@@ -33,8 +34,16 @@ struct ProposalOptions {
 std::vector<SquareRegion> proposal_tiles(int width, int height, int tiles,
                                          bool whole_frame = false);
 
+// The input (height, width) at which MB3-CenterNet sees a width × height frame at its own aspect:
+// the short side at the model's 512, the long side scaled alike and rounded to the graph's stride
+// of 32 (1280 × 720: 512 × 896, 768 × 576: 512 × 672; people 0.71 × 0.70 of their size instead of
+// squeezed 0.40 × 0.71 across and down).
+std::pair<int, int> centernet_input_at_aspect(int width, int height);
+
 // Person detections in frame pixels, best first. `input` is the network's input, reused between
-// calls. Throws std::invalid_argument for tiles < 1.
+// calls. One whole-frame pass (tiles 1, or the whole frame added to tiles) is stretched to the
+// network's input, whatever its shape; tiles need a square one. Throws std::invalid_argument for
+// tiles < 1 or tiles on a network whose input is not square.
 std::vector<Detection> propose_people(CenternetNetwork& network, const ImageBuffer& frame,
                                       const ProposalOptions& options, GraphTensor& input);
 

@@ -276,6 +276,41 @@ TfjsModel parse_tfjs_model(std::string_view model_json, std::string_view weights
   return build_model(parse_json(model_json, name), weights, name);
 }
 
+TfjsModel tfjs_with_input_size(TfjsModel model, std::int64_t height, std::int64_t width) {
+  const auto fail = [&](const std::string& why) {
+    return ModelError(model.file.string() + ": cannot take a " + std::to_string(height) + " x " +
+                      std::to_string(width) + " input: " + why);
+  };
+  TfjsAttr* declared = nullptr;
+  for (TfjsNode& n : model.nodes) {
+    if (n.op != "Placeholder") continue;
+    const auto shape = n.attr.find("shape");
+    if (declared || shape == n.attr.end() || shape->second.shape.size() != 4)
+      throw fail("not one 4-D input");
+    declared = &shape->second;
+  }
+  if (!declared || declared->shape[1] < 1 || declared->shape[2] < 1 || height < 1 || width < 1)
+    throw fail("no input of a known size");
+  const std::int64_t h0 = declared->shape[1], w0 = declared->shape[2];
+  declared->shape[1] = height;
+  declared->shape[2] = width;
+  std::set<std::string> scaled;  // a size shared by several resizes is scaled once
+  for (const TfjsNode& n : model.nodes) {
+    if (n.op != "ResizeBilinear" || n.inputs.size() < 2) continue;
+    const std::string name = tfjs_base_name(n.inputs[1]);
+    const auto size = model.weights.find(name);
+    // A size computed from the input's shape scales by itself.
+    if (size == model.weights.end() || !scaled.insert(name).second) continue;
+    auto& ints = size->second.ints;
+    if (!size->second.is_int || ints.size() != 2) throw fail(n.name + ": a size not of 2 ints");
+    if (ints[0] * height % h0 != 0 || ints[1] * width % w0 != 0)
+      throw fail(n.name + ": its size does not scale to whole pixels");
+    ints[0] = static_cast<std::int32_t>(ints[0] * height / h0);
+    ints[1] = static_cast<std::int32_t>(ints[1] * width / w0);
+  }
+  return model;
+}
+
 std::string tfjs_resolve(const TfjsModel& model, const std::string& name) {
   const auto it = model.bypassed.find(name);
   return it == model.bypassed.end() ? name : it->second;

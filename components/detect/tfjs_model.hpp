@@ -80,6 +80,14 @@ TfjsModel read_tfjs_model(const std::filesystem::path& model_json);
 TfjsModel parse_tfjs_model(std::string_view model_json, std::string_view weights,
                            const std::filesystem::path& name);
 
+// The model for an NHWC image input of height × width instead of the size its one Placeholder
+// declares, for a fully convolutional graph: the Placeholder's shape is changed and every
+// ResizeBilinear whose output size is a constant (Keras' UpSampling2D, frozen at the declared
+// size by the converter) gets that size scaled as the input's. Throws ModelError when the model
+// has not exactly one 4-D Placeholder or a scaled size is not a whole number (height and width
+// must keep the graph's strides: for MB3-CenterNet, multiples of 32).
+TfjsModel tfjs_with_input_size(TfjsModel model, std::int64_t height, std::int64_t width);
+
 // The outputs and every node they depend on, up to `input_node` (fed from outside: its own inputs
 // are not needed; empty: none). Throws ModelError for a name the graph lacks.
 std::set<std::string> tfjs_ancestors(const TfjsModel& model, std::span<const std::string> outputs,

@@ -42,6 +42,10 @@ void check(const TopDownOptions& o) {
     throw std::invalid_argument("small_box_height must be >= 0 and small_crop_padding in [1, 4]");
   if (o.workers < 1 || o.workers > 16) throw std::invalid_argument("workers must lie in [1, 16]");
   if (o.keypoint_every < 1) throw std::invalid_argument("keypoint_every must be at least 1");
+  if (!(o.followed_overlap > 0.0f && o.followed_overlap < 1.0f))
+    throw std::invalid_argument("followed_overlap must lie in (0, 1)");
+  if (!(o.duplicate_similarity >= 0.0f && o.duplicate_similarity <= 1.0f))
+    throw std::invalid_argument("duplicate_similarity must lie in [0, 1] (0: off)");
   if (!(o.flow_error > 0.0f && o.flow_error <= 1.0f))
     throw std::invalid_argument("flow_error must lie in (0, 1]");
 }
@@ -96,6 +100,38 @@ CropVerdict judge_crop(const SinglePose& pose, const TopDownOptions& options) {
     v.posed = pose.presence >= options.min_pose_presence && v.passing >= 2;
   }
   return v;
+}
+
+std::vector<int> followed_boxes(std::span<const Box2D> followed,
+                                std::span<const Detection> detections, float min_overlap,
+                                bool one_each) {
+  std::vector<int> owner(detections.size(), -1);
+  const float least = min_overlap;
+  if (!one_each) {
+    // Every box overlapping a followed person's is theirs.
+    for (std::size_t d = 0; d < detections.size(); ++d)
+      for (std::size_t i = 0; i < followed.size() && owner[d] < 0; ++i)
+        if (iou(followed[i], detections[d].box) > least) owner[d] = static_cast<int>(i);
+    return owner;
+  }
+  struct Pair {
+    float overlap;
+    std::size_t d, i;
+  };
+  std::vector<Pair> pairs;
+  for (std::size_t d = 0; d < detections.size(); ++d)
+    for (std::size_t i = 0; i < followed.size(); ++i)
+      if (const float v = iou(followed[i], detections[d].box); v > least)
+        pairs.push_back({v, d, i});
+  std::stable_sort(pairs.begin(), pairs.end(),
+                   [](const Pair& a, const Pair& b) { return a.overlap > b.overlap; });
+  std::vector<std::uint8_t> taken(followed.size(), 0);
+  for (const Pair& p : pairs) {
+    if (owner[p.d] >= 0 || taken[p.i]) continue;
+    owner[p.d] = static_cast<int>(p.i);
+    taken[p.i] = 1;
+  }
+  return owner;
 }
 
 SquareRegion crop_region(const Box2D& box, const TopDownOptions& options) {
@@ -180,7 +216,8 @@ TopDownDetector::TopDownDetector(const TopDownOptions& options,
                                  const std::filesystem::path& pose_model_json,
                                  const std::filesystem::path& centernet_json)
     : options_((check(options), options)),
-      boxes_(std::make_unique<CenternetNetwork>(centernet_json, runner_options(options))) {
+      boxes_(std::make_unique<CenternetNetwork>(centernet_json, runner_options(options))),
+      centernet_json_(centernet_json) {
   for (int i = 0; i < options_.workers; ++i)
     poses_.push_back(std::make_unique<SinglePoseNetwork>(options_.pose_model, pose_model_json,
                                                          runner_options(options_)));
@@ -198,7 +235,8 @@ void TopDownDetector::reset() {
 }
 
 void TopDownDetector::warm_up() {
-  image_batch(image_, 1, kCenternetInput, kCenternetInput);
+  // With detector_aspect the network for the frame's aspect is made on the first frame.
+  image_batch(image_, 1, boxes_->input_height(), boxes_->input_width());
   boxes_->run(image_);
   // The shapes SinglePoseNetwork::run passes: 8, 4, 2 and 1 crops, on every copy.
   const int copies = static_cast<int>(poses_.size());
@@ -213,6 +251,13 @@ void TopDownDetector::warm_up() {
 
 std::vector<Detection> TopDownDetector::find_boxes(const ImageBuffer& frame) {
   const auto start = Clock::now();
+  if (options_.detector_aspect && options_.detector_tiles == 1) {
+    // The network for this frame's aspect (made again only when the frame's shape changes).
+    const auto [height, width] = centernet_input_at_aspect(frame.width(), frame.height());
+    if (boxes_->input_height() != height || boxes_->input_width() != width)
+      boxes_ = std::make_unique<CenternetNetwork>(centernet_json_, height, width,
+                                                  runner_options(options_));
+  }
   std::vector<Detection> found =
       propose_people(*boxes_, frame,
                      {options_.min_box_score, options_.box_overlap, options_.detector_tiles,
@@ -279,6 +324,7 @@ void TopDownDetector::people_found(const ImageBuffer& frame, std::vector<Found>&
     }
     const CropVerdict verdict = judge_crop(found_[i], options_);
     person.score = verdict.score;
+    if (split_[i]) continue;  // split into the detector's boxes (split_followed)
     const float box_score = box_scores_[i];
     const bool agrees = options_.newcomer_agreement <= 0 || !newcomer_[i] ||
                         iou(posed_box(found_[i], r, options_, frame.width(), frame.height()),
@@ -290,7 +336,7 @@ void TopDownDetector::people_found(const ImageBuffer& frame, std::vector<Found>&
     person.box =
         posed ? posed_box(found_[i], r, options_, frame.width(), frame.height()) : crop_boxes_[i];
     const Box2D follow = posed ? posed_crop_box(found_[i], r, options_) : crop_boxes_[i];
-    found.push_back({person, follow, 0, box_score, posed});
+    found.push_back({person, follow, 0, box_score, posed, static_cast<int>(i)});
   }
 }
 
@@ -351,6 +397,24 @@ void TopDownDetector::carry(std::vector<Found>& out) {
   profile_.flow += seconds_since(start);
 }
 
+void TopDownDetector::record_crops(const std::vector<Found>& found,
+                                   const std::vector<DuplicateRule>& why) {
+  using Fate = TopDownTrace::Fate;
+  trace_.crops.assign(crop_boxes_.size(), {});
+  for (std::size_t i = 0; i < crop_boxes_.size(); ++i)
+    trace_.crops[i] = {
+        crop_boxes_[i], newcomer_[i] != 0, {}, split_[i] ? Fate::split : Fate::rejected};
+  for (std::size_t f = 0; f < found.size(); ++f) {
+    if (found[f].crop < 0) continue;
+    TopDownTrace::Crop& c = trace_.crops[static_cast<std::size_t>(found[f].crop)];
+    c.found = found[f].person.box;
+    c.fate = why[f] == DuplicateRule::none             ? Fate::kept
+             : why[f] == DuplicateRule::box_overlap    ? Fate::duplicate_box
+             : why[f] == DuplicateRule::same_keypoints ? Fate::duplicate_keypoints
+                                                       : Fate::duplicate_similarity;
+  }
+}
+
 std::vector<MovenetPerson> TopDownDetector::detect(const ImageBuffer& frame) {
   const auto start = Clock::now();
   if (flow_) {
@@ -364,14 +428,19 @@ std::vector<MovenetPerson> TopDownDetector::detect(const ImageBuffer& frame) {
   std::vector<Box2D> boxes;
   box_scores_.clear();
   newcomer_.clear();
+  split_.clear();
   for (std::size_t i = 0; i < followed_.size(); ++i) {
     if (carried_[i]) continue;
     boxes.push_back(moved(followed_[i].box, followed_[i].vx, followed_[i].vy));
     box_scores_.push_back(followed_[i].box_score);
     newcomer_.push_back(0);
+    split_.push_back(0);
   }
   const bool run_detector =
       frame_ % options_.detect_every == 0 || lost_someone_ || followed_.empty();
+  trace_.detector_ran = run_detector;
+  trace_.detections.clear();
+  trace_.taken_for.clear();
   ++frame_;
   regions_.clear();
   crop_boxes_.clear();
@@ -402,26 +471,44 @@ std::vector<MovenetPerson> TopDownDetector::detect(const ImageBuffer& frame) {
       profile_.centernet_wait += seconds_since(running);
     }
     const std::size_t followed = boxes.size();
-    // A followed person's detector score is the best of the boxes that are them (0: none).
+    if (options_.split_followed) {
+      // A followed box over two detector boxes or more is that many people: their crop is set
+      // aside (its box empty, overlapping nothing) and each box becomes a newcomer.
+      for (std::size_t i = 0; i < followed; ++i) {
+        const auto over = std::count_if(detections.begin(), detections.end(), [&](const auto& d) {
+          return iou(boxes[i], d.box) > options_.followed_overlap;
+        });
+        if (over >= 2) split_[i] = 1;
+      }
+    }
+    std::vector<Box2D> claimants(boxes.begin(),
+                                 boxes.begin() + static_cast<std::ptrdiff_t>(followed));
+    for (std::size_t i = 0; i < followed; ++i)
+      if (split_[i]) claimants[i] = {};
+    const std::vector<int> owner = followed_boxes(claimants, detections, options_.followed_overlap,
+                                                  options_.one_box_per_followed);
+    // A followed person's detector score is the best of the boxes that are them (0: none): with
+    // one_box_per_followed their own box's, else that of every box overlapping them.
     for (std::size_t i = 0; i < followed; ++i) {
       box_scores_[i] = 0;
-      for (const Detection& d : detections)
-        if (iou(boxes[i], d.box) > options_.followed_overlap)
-          box_scores_[i] = std::max(box_scores_[i], d.score);
+      for (std::size_t d = 0; d < detections.size(); ++d)
+        if (options_.one_box_per_followed
+                ? owner[d] == static_cast<int>(i)
+                : iou(claimants[i], detections[d].box) > options_.followed_overlap)
+          box_scores_[i] = std::max(box_scores_[i], detections[d].score);
     }
-    for (const Detection& d : detections) {
-      const auto overlaps = [&](const Box2D& b) {
-        return iou(b, d.box) > options_.followed_overlap;
-      };
-      const bool known =
-          std::any_of(boxes.begin(), boxes.begin() + static_cast<std::ptrdiff_t>(followed),
-                      overlaps) ||
-          std::any_of(found.begin(), found.end(),
-                      [&](const Found& c) { return overlaps(c.person.box); });
-      if (!known) {
-        boxes.push_back(d.box);
-        box_scores_.push_back(d.score);
+    trace_.detections = detections;
+    for (std::size_t d = 0; d < detections.size(); ++d) {
+      const Box2D& box = detections[d].box;
+      const bool carried = std::any_of(found.begin(), found.end(), [&](const Found& c) {
+        return iou(c.person.box, box) > options_.followed_overlap;
+      });
+      trace_.taken_for.push_back(owner[d] >= 0 ? owner[d] : carried ? -2 : -1);
+      if (owner[d] < 0 && !carried) {
+        boxes.push_back(box);
+        box_scores_.push_back(detections[d].score);
         newcomer_.push_back(1);
+        split_.push_back(0);
       }
     }
   }
@@ -436,8 +523,12 @@ std::vector<MovenetPerson> TopDownDetector::detect(const ImageBuffer& frame) {
       candidates.push_back(f.person);
       if (f.posed) candidates.back().score += 1;
     }
-    kept = distinct_people(candidates, options_.duplicate_overlap);
+    std::vector<DuplicateRule> why;
+    kept = distinct_people(
+        candidates, DuplicateTest{options_.duplicate_overlap, 0.05f, options_.duplicate_similarity},
+        &why);
     for (const std::size_t i : kept) people.push_back(found[i].person);
+    record_crops(found, why);
   }
 
   // The next frame's crops: each person's box, moved by how far their nearest predecessor moved.

@@ -47,8 +47,22 @@ struct TopDownOptions {
   // With detector_tiles > 1: one more detector pass over the whole frame stretched, for the
   // people wider than the tiles' overlap (close-ups); all passes merged by NMS.
   bool detector_whole_frame = false;
+  // With detector_tiles 1: CenterNet sees the frame at its own aspect (short side 512, long side
+  // scaled alike to a multiple of 32: 512 × 896 for 1280 × 720; centernet_input_at_aspect)
+  // instead of squeezed to 512 × 512, which shrinks a 16:9 frame's people to 0.40 of their width.
+  // Costs the pixels' ratio in CenterNet's time (1.75× at 16:9), on its runs only.
+  bool detector_aspect = false;
   // A detector box overlapping a followed person's box by more than this is that person.
   float followed_overlap = 0.3f;
+  // On a detector run, each followed person is at most one detector box (the pairs overlapping
+  // most matched first); a second box overlapping them is a newcomer and gets its own crop, so
+  // that one of two people embracing or crossing, followed as one box, is looked for. Off: every
+  // box overlapping a followed person's is that person.
+  bool one_box_per_followed = false;
+  // On a detector run, a followed person whose box overlaps two or more detector boxes (each by
+  // more than followed_overlap) is that many people: two people embracing or crossing whom one
+  // crop's landmarks span as one box. Their crop is set aside and each box gets its own crop.
+  bool split_followed = false;
   float crop_padding = 1.25f;  // crop side = longer box side × this
   // A box shorter than small_box_height px (0: none) gets a crop of side longer box side ×
   // small_crop_padding instead: more context around a small person, whose detector box is
@@ -91,6 +105,13 @@ struct TopDownOptions {
   // the evaluation and the detector's NMS call two boxes one person.
   float newcomer_agreement = 0.0f;
   float duplicate_overlap = 0.6f;  // people whose boxes overlap more are one
+  // Two finds of a frame with at least 3 keypoints in common are one person only when their
+  // keypoint similarity (COCO's OKS, person_boxes.hpp) reaches this, however much their boxes
+  // overlap, so that two people embracing or crossing stay two; finds with fewer keypoints in
+  // common are compared by duplicate_overlap. 0: off (box overlap or most keypoints within 5 % of
+  // the person's size, as before). 0.9 a priori: the OKS threshold of the top-down pose
+  // estimators' duplicate removal (HRNet's and MMPose's COCO test settings, oks_thr 0.9).
+  float duplicate_similarity = 0.0f;
   // The network runtime of both networks and their threads (graph_runner.hpp: XNNPACK's are each
   // network's own, 0 meaning one; cv::dnn's are process-wide, 0 its default).
   Backend backend = Backend::automatic;
@@ -118,6 +139,15 @@ struct CropVerdict {
   bool posed = false;
 };
 CropVerdict judge_crop(const SinglePose& pose, const TopDownOptions& options);
+
+// Which followed person each detector box is: per detection, the index of the followed box
+// (their predicted box) it overlaps by IoU > min_overlap, or -1 (a newcomer). With `one_each`
+// each followed person is at most one box, the pairs overlapping most matched first (greedy, as
+// SORT-like trackers associate): a second box on them is somebody else; without, every box
+// overlapping them is them (the first such person's).
+std::vector<int> followed_boxes(std::span<const Box2D> followed,
+                                std::span<const Detection> detections, float min_overlap,
+                                bool one_each);
 
 // The square a box's crop is cut from: its longer side × crop_padding, or × small_crop_padding
 // for a box shorter than small_box_height.
@@ -152,6 +182,32 @@ inline constexpr BoxMargins kLandmarkBoxMargins{0.07f, 0.0f, 0.03f};
 // acromion): 110 / (1630 - 1425) = 0.54 for British men, 105 / (1505 - 1310) = 0.54 for women
 // (50th percentiles, Pheasant's tables as above; shoulder height there). A priori, not fitted.
 inline constexpr float kHeadAboveEyesPerEyeToShoulder = 0.54f;
+
+// What the last detect() did with each box of the frame, for diagnosis (mocap-bench-detect
+// --diagnose: which rule dropped a person the detector had proposed).
+struct TopDownTrace {
+  enum class Fate : std::uint8_t {
+    rejected,              // the crop's keypoints failed the person test
+    kept,                  // a person of the frame
+    duplicate_box,         // dropped: box overlap with a kept person (duplicate_overlap)
+    duplicate_keypoints,   // dropped: most keypoints on a kept person's
+    duplicate_similarity,  // dropped: keypoint similarity (duplicate_similarity)
+    split                  // set aside: a followed box over several detector boxes
+  };
+  struct Crop {
+    Box2D box;              // the box it was cut around
+    bool newcomer = false;  // a detector box nobody followed (else a followed person's)
+    Box2D found;            // the person's box when it passed (empty otherwise)
+    Fate fate = Fate::rejected;
+  };
+  bool detector_ran = false;
+  std::vector<Detection> detections;  // the detector's boxes (after NMS), when it ran
+  // Per detection: the crop of the followed person it was taken for (its box overlapped theirs
+  // by more than followed_overlap), or -1 when it got a crop of its own (newcomer), or -2 when
+  // it was taken for a person carried by optical flow.
+  std::vector<int> taken_for;
+  std::vector<Crop> crops;
+};
 
 // Where the time of detect() went, summed over the frames since the detector was made (seconds,
 // wall clock). CenterNet runs on a helper thread when there are several workers, then overlapping
@@ -189,6 +245,8 @@ class TopDownDetector {
   // Frames on which the person detector ran, of all frames seen.
   long long detector_runs() const { return profile_.detector_runs; }
   const TopDownProfile& profile() const { return profile_; }
+  // What the last detect() did with each box (cheap: kept on every frame).
+  const TopDownTrace& trace() const { return trace_; }
 
  private:
   struct Followed {
@@ -207,6 +265,7 @@ class TopDownDetector {
     int carried = 0;
     float box_score = 0;
     bool posed = true;
+    int crop = -1;  // the crop of the frame it came from (-1: carried by optical flow)
   };
   std::vector<Detection> find_boxes(const ImageBuffer& frame);
   // Keypoints of a crop for each box, appended to found_ (regions_ gets their squares), the
@@ -217,6 +276,8 @@ class TopDownDetector {
   void run_keypoints(int first, int count, int copies);
   // People of the crops of this frame, appended to `found`.
   void people_found(const ImageBuffer& frame, std::vector<Found>& found) const;
+  // Each crop of the frame and what became of it into trace_ (`why`: per find of `found`).
+  void record_crops(const std::vector<Found>& found, const std::vector<DuplicateRule>& why);
   // The followed people due no keypoint pass moved into this frame by optical flow, appended to
   // `out`; marks in carried_ which were (the others need a crop).
   void carry(std::vector<Found>& out);
@@ -224,12 +285,14 @@ class TopDownDetector {
   TopDownOptions options_;
   std::vector<std::unique_ptr<SinglePoseNetwork>> poses_;  // copy 0 runs on the calling thread
   std::unique_ptr<CenternetNetwork> boxes_;
+  std::filesystem::path centernet_json_;          // to make boxes_ again at another frame's aspect
   std::unique_ptr<OrderedWorkers<int>> helpers_;  // workers - 1 threads; none with one worker
   GraphTensor image_, crops_;  // the networks' inputs, reused from frame to frame
   std::vector<SquareRegion> regions_;
   std::vector<Box2D> crop_boxes_;       // per crop of the frame: the box it was cut around
   std::vector<float> box_scores_;       // per box of the frame: the detector's score of it
   std::vector<std::uint8_t> newcomer_;  // per box of the frame: a detector box nobody followed
+  std::vector<std::uint8_t> split_;     // per box: a followed box split (split_followed)
   std::vector<SinglePose> found_;
   std::vector<Followed> followed_;
   std::unique_ptr<KeypointFlow> flow_;  // with keypoint_every > 1
@@ -239,6 +302,7 @@ class TopDownDetector {
   long long frame_ = 0;
   bool lost_someone_ = false;
   TopDownProfile profile_;
+  TopDownTrace trace_;
 };
 
 }  // namespace mocap::detect

@@ -4,13 +4,17 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdint>
 #include <filesystem>
 #include <optional>
 #include <stdexcept>
+#include <utility>
 #include <vector>
 
 #include <opencv2/imgcodecs.hpp>
 
+#include "detect/centernet.hpp"
+#include "detect/image_tensor.hpp"
 #include "detect/model_files.hpp"
 #include "detect/person_proposals.hpp"
 #include "support/images.hpp"
@@ -57,6 +61,13 @@ TEST(PersonProposalTiles, TheWholeFrameComesLastWhenAdded) {
 }
 
 // The real CenterNet and a picture, or a skip naming what is absent.
+TEST(CenternetAtAspect, TheShortSideAt512TheLongSideScaledToTheStride) {
+  EXPECT_EQ(centernet_input_at_aspect(1280, 720), std::pair(512, 896));  // video.avi
+  EXPECT_EQ(centernet_input_at_aspect(768, 576), std::pair(512, 672));   // vtest.avi
+  EXPECT_EQ(centernet_input_at_aspect(480, 640), std::pair(672, 512));   // portrait
+  EXPECT_EQ(centernet_input_at_aspect(600, 600), std::pair(512, 512));
+}
+
 class PersonProposals : public ::testing::Test {
  protected:
   void load(const fs::path& image_file) {
@@ -80,6 +91,36 @@ class PersonProposals : public ::testing::Test {
   std::optional<CenternetNetwork> network;
   GraphTensor input;
 };
+
+// The graph fed at the frame's aspect (its frozen upsampling sizes scaled): heads of the input's
+// quarter size, and the walkers of vtest frame 300 the squeezed frame finds at 0.5 found again
+// there (768 × 576 at 512 × 672). Sides that are not multiples of the graph's stride are refused.
+TEST_F(PersonProposals, CenternetAtTheFramesAspectFindsWhatTheSqueezedFrameFinds) {
+  ASSERT_NO_FATAL_FAILURE(load(test::kVtestFrame300));
+  if (IsSkipped()) return;
+  ProposalOptions confident;
+  confident.min_score = 0.5f;
+  const auto squeezed = propose(confident);
+  ASSERT_GE(squeezed.size(), 3u) << "the walkers of frame 300 score 0.55-0.67";
+  const auto [height, width] = centernet_input_at_aspect(frame.width(), frame.height());
+  CenternetNetwork at_aspect(cached_model_json("centernet"), height, width);
+  image_batch(input, 1, height, width);
+  fill_stretched(frame, input, 0);
+  const auto& heads = at_aspect.run(input);
+  EXPECT_EQ(heads[0].shape, (std::vector<std::int64_t>{1, height / 4, width / 4, 80}));
+  ProposalOptions low = confident;
+  low.min_score = 0.3f;  // scores move with the scale; the boxes must be there
+  const auto found = propose_people(at_aspect, frame, low, input);
+  for (const Detection& s : squeezed) {
+    const bool again = std::any_of(found.begin(), found.end(),
+                                   [&](const Detection& d) { return iou(s.box, d.box) > 0.5f; });
+    EXPECT_TRUE(again) << "a person at x " << s.box.x << ", y " << s.box.y << " lost at aspect";
+  }
+  ProposalOptions tiled;
+  tiled.tiles = 2;
+  EXPECT_THROW(propose_people(at_aspect, frame, tiled, input), std::invalid_argument);
+  EXPECT_THROW(CenternetNetwork(cached_model_json("centernet"), 500, 896), std::invalid_argument);
+}
 
 TEST_F(PersonProposals, TilesFindThePeopleTheStretchedFrameFinds) {
   ASSERT_NO_FATAL_FAILURE(load(test::kVtestFrame300));

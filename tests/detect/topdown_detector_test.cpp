@@ -351,6 +351,66 @@ TEST(TopDownDetector, NewcomersWhosePoseDisagreesWithTheirBoxAreNotPeople) {
   EXPECT_THROW(TopDownDetector(o, m->lightning, m->centernet), std::invalid_argument);
 }
 
+// The rules for people followed as one box (one_box_per_followed, duplicate_similarity) and
+// CenterNet at the frame's aspect only add people on frame 300's walkers, who stand apart: each
+// person found without them is found with them, on a detector run and a followed frame.
+TEST(TopDownDetector, TheRulesForPeopleAsOneBoxKeepThePeopleFoundApart) {
+  std::string why;
+  const auto m = models(why);
+  if (!m) GTEST_SKIP() << why;
+  TopDownOptions o;
+  o.detect_every = 2;
+  const Frames plain = run(*m, o, 2);
+  o.one_box_per_followed = true;
+  o.split_followed = true;
+  o.duplicate_similarity = 0.9f;
+  o.detector_aspect = true;
+  const Frames ruled = run(*m, o, 2);
+  ASSERT_EQ(plain.people.size(), ruled.people.size());
+  for (std::size_t f = 0; f < plain.people.size(); ++f) {
+    SCOPED_TRACE(f);
+    EXPECT_GE(plain.people[f].size(), 3u);
+    for (const MovenetPerson& p : plain.people[f]) {
+      const bool again =
+          std::any_of(ruled.people[f].begin(), ruled.people[f].end(),
+                      [&](const MovenetPerson& q) { return iou(p.box, q.box) > 0.5f; });
+      EXPECT_TRUE(again) << "the person at x " << p.box.x << " lost";
+    }
+  }
+  o.duplicate_similarity = 1.5f;
+  EXPECT_THROW(TopDownDetector(o, m->lightning, m->centernet), std::invalid_argument);
+}
+
+// The trace says what became of each box: on the first frame every detector box is a newcomer
+// with its own crop, and the crops kept are the people returned; on the next (no detector run)
+// every crop is a followed person's.
+TEST(TopDownDetector, TheTraceAccountsForEveryBox) {
+  std::string why;
+  const auto m = models(why);
+  if (!m) GTEST_SKIP() << why;
+  TopDownDetector detector(TopDownOptions{}, m->lightning, m->centernet);
+  using Fate = TopDownTrace::Fate;
+  const auto kept = [](const TopDownTrace& t) {
+    return std::count_if(t.crops.begin(), t.crops.end(),
+                         [](const TopDownTrace::Crop& c) { return c.fate == Fate::kept; });
+  };
+  const auto first = detector.detect(shifted_frame(0));
+  const TopDownTrace t0 = detector.trace();
+  EXPECT_TRUE(t0.detector_ran);
+  ASSERT_EQ(t0.taken_for.size(), t0.detections.size());
+  EXPECT_EQ(t0.crops.size(), t0.detections.size());
+  for (const int taken : t0.taken_for) EXPECT_EQ(taken, -1);
+  for (const auto& c : t0.crops) EXPECT_TRUE(c.newcomer);
+  EXPECT_EQ(kept(t0), static_cast<long>(first.size()));
+  const auto second = detector.detect(shifted_frame(2));
+  const TopDownTrace t1 = detector.trace();
+  EXPECT_FALSE(t1.detector_ran);
+  EXPECT_TRUE(t1.detections.empty());
+  EXPECT_EQ(t1.crops.size(), first.size());
+  for (const auto& c : t1.crops) EXPECT_FALSE(c.newcomer);
+  EXPECT_EQ(kept(t1), static_cast<long>(second.size()));
+}
+
 // Frames 0..5 of the moving picture with the keypoint network every frame, then every third.
 TEST(TopDownDetector, KeypointsCarriedByFlowStayWithTheNetworksBetweenPasses) {
   std::string why;

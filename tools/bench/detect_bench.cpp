@@ -57,6 +57,8 @@ struct Strategy {
   // Top-down only: where its time went (zero elsewhere).
   std::function<detect::TopDownProfile()> profile = [] { return detect::TopDownProfile{}; };
   std::optional<detect::TopDownOptions> topdown;  // a top-down strategy's settings
+  // Top-down only: what its last frame did with each box (for --diagnose).
+  std::function<detect::TopDownTrace()> trace = [] { return detect::TopDownTrace{}; };
 };
 
 std::vector<std::string> split(const std::string& text, char sep) {
@@ -101,7 +103,7 @@ Strategy make_strategy(const std::string& spec, detect::Backend backend, int thr
     } catch (const std::invalid_argument&) {
       throw std::invalid_argument(
           "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:kEVERY][:uSURE][:"
-          "bPRESENCE][:m0][:h1][:cH[xP]][:aIOU] with "
+          "bPRESENCE][:m0][:h1][:cH[xP]][:aIOU][:oOKS][:n1][:x1][:r1] with "
           "MODEL " +
           std::string(detect::pose_model_names()) + ", got " + spec);
     }
@@ -126,6 +128,14 @@ Strategy make_strategy(const std::string& spec, detect::Backend backend, int thr
         o.anatomical_landmark_box = false;
       else if (parts[i].size() > 1 && parts[i][0] == 'a')
         o.newcomer_agreement = std::stof(parts[i].substr(1));
+      else if (parts[i].size() > 1 && parts[i][0] == 'o')
+        o.duplicate_similarity = std::stof(parts[i].substr(1));
+      else if (parts[i] == "n1")
+        o.one_box_per_followed = true;
+      else if (parts[i] == "x1")
+        o.split_followed = true;
+      else if (parts[i] == "r1")
+        o.detector_aspect = true;
       else if (parts[i] == "h1")
         o.head_margin_from_shoulders = true;
       else if (parts[i].size() > 1 && parts[i][0] == 'c') {
@@ -141,7 +151,7 @@ Strategy make_strategy(const std::string& spec, detect::Backend backend, int thr
     if (numbers.size() > 2)
       throw std::invalid_argument(
           "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:kEVERY][:uSURE][:"
-          "bPRESENCE][:m0][:h1][:cH[xP]][:aIOU], got " +
+          "bPRESENCE][:m0][:h1][:cH[xP]][:aIOU][:oOKS][:n1][:x1][:r1], got " +
           spec);
     o.backend = backend;
     o.threads = numbers.size() == 2 ? std::stoi(numbers[1]) : threads;
@@ -150,13 +160,18 @@ Strategy make_strategy(const std::string& spec, detect::Backend backend, int thr
         o, detect::cached_model_json(detect::model_name(o.pose_model)),
         detect::cached_model_json("centernet"));
     d->warm_up();
-    return {spec, [d](const ImageBuffer& f) { return d->detect(f); }, [d] { d->reset(); },
-            [d] { return d->profile(); }, o};
+    return {spec,
+            [d](const ImageBuffer& f) { return d->detect(f); },
+            [d] { d->reset(); },
+            [d] { return d->profile(); },
+            o,
+            [d] { return d->trace(); }};
   }
-  throw std::invalid_argument("unknown strategy '" + spec +
-                              "' (multipose:SIZE, tiles:CxR:TILE:FRAME, "
-                              "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:"
-                              "kEVERY][:uSURE][:bPRESENCE][:m0][:h1][:cH[xP]][:aIOU])");
+  throw std::invalid_argument(
+      "unknown strategy '" + spec +
+      "' (multipose:SIZE, tiles:CxR:TILE:FRAME, "
+      "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:"
+      "kEVERY][:uSURE][:bPRESENCE][:m0][:h1][:cH[xP]][:aIOU][:oOKS][:n1][:x1][:r1])");
 }
 
 // Every frame of a video, or the one image of a still.
@@ -194,7 +209,8 @@ struct Run {
   std::map<int, People> people;  // every frame
   double seconds = 0;
   int frames = 0;
-  detect::TopDownProfile profile;  // of the timed frames (top-down only)
+  detect::TopDownProfile profile;              // of the timed frames (top-down only)
+  std::map<int, detect::TopDownTrace> traces;  // top-down only: the frames in `keep_traces`
 };
 
 detect::TopDownProfile minus(detect::TopDownProfile a, const detect::TopDownProfile& b) {
@@ -206,8 +222,10 @@ detect::TopDownProfile minus(detect::TopDownProfile a, const detect::TopDownProf
   return a;
 }
 
-// Every frame in order, or only those in `only` (sorted; empty: all).
-Run run(Strategy& s, const std::string& input, const std::vector<int>& only) {
+// Every frame in order, or only those in `only` (sorted; empty: all); the top-down trace of the
+// frames in `keep_traces` (sorted) is kept.
+Run run(Strategy& s, const std::string& input, const std::vector<int>& only,
+        const std::vector<int>& keep_traces) {
   Run r;
   {
     // cv::dnn sets its layers up on the first forward pass (several times a later one): done
@@ -224,6 +242,8 @@ Run run(Strategy& s, const std::string& input, const std::vector<int>& only) {
     if (!f) break;
     if (!only.empty() && !std::binary_search(only.begin(), only.end(), i)) continue;
     r.people[i] = s.detect(*f);
+    if (s.topdown && std::binary_search(keep_traces.begin(), keep_traces.end(), i))
+      r.traces[i] = s.trace();
     ++r.frames;
   }
   r.seconds = std::chrono::duration<double>(Clock::now() - start).count();
@@ -329,6 +349,57 @@ json candidates(const std::string& input, const Run& reference, const std::vecto
   return {{"input", input}, {"min_height", min_height}, {"frames", frames}};
 }
 
+// Which rule of the run lost a person whose proposal, cropped alone, shows them ((c3)), from the
+// run's trace of the frame: the detector's box near them taken for a followed person, their crop
+// dropped as a duplicate (by which rule), kept with a box elsewhere, or, between detector runs,
+// no crop near them.
+std::string dropped_by(const detect::TopDownTrace& t, const Box2D& truth) {
+  using Fate = detect::TopDownTrace::Fate;
+  const auto fate = [](Fate f) {
+    switch (f) {
+      case Fate::rejected:
+        return "rejected";
+      case Fate::kept:
+        return "kept, box elsewhere (merged or a neighbour's)";
+      case Fate::duplicate_box:
+        return "dropped as duplicate: box IoU";
+      case Fate::duplicate_keypoints:
+        return "dropped as duplicate: same keypoints";
+      case Fate::duplicate_similarity:
+        return "dropped as duplicate: keypoint similarity";
+      case Fate::split:
+        return "set aside (split into the detector's boxes)";
+    }
+    return "?";
+  };
+  const auto nearest = [&](auto&& boxes, std::size_t n) {
+    int best = -1;
+    float best_iou = 0.3f;
+    for (std::size_t i = 0; i < n; ++i)
+      if (const float v = detect::iou(boxes(i), truth); v >= best_iou)
+        best = static_cast<int>(i), best_iou = v;
+    return best;
+  };
+  const auto crop_box = [&](std::size_t i) { return t.crops[i].box; };
+  if (!t.detector_ran) {
+    const int c = nearest(crop_box, t.crops.size());
+    if (c < 0) return "(c3) not followed, no detector run on the frame";
+    return std::string("(c3) no detector run, nearest crop ") +
+           fate(t.crops[static_cast<std::size_t>(c)].fate);
+  }
+  const int d = nearest([&](std::size_t i) { return t.detections[i].box; }, t.detections.size());
+  if (d < 0) return "(c3) detector ran, no box near them in the run";
+  const int taken = t.taken_for[static_cast<std::size_t>(d)];
+  if (taken == -2) return "(c3) their box taken for a person carried by flow";
+  if (taken >= 0)
+    return std::string("(c3) their box taken for a followed person (IoU > followed_overlap), ") +
+           "whose crop was " + fate(t.crops[static_cast<std::size_t>(taken)].fate);
+  for (const auto& c : t.crops)
+    if (c.newcomer && detect::iou(c.box, t.detections[static_cast<std::size_t>(d)].box) > 0.99f)
+      return std::string("(c3) their own crop ") + fate(c.fate);
+  return "(c3) detector ran, their box not cropped";
+}
+
 // Why each true person a top-down strategy missed was missed (--diagnose): its person detector
 // is run again on the annotated frames at the score floor `floor`, and each missed box is put in
 // one cause: (d) a person was found near it but their box matches at IoU < min_iou (nearest
@@ -343,7 +414,18 @@ void diagnose(const std::string& input, const eval::DetectionTruth& truth, const
   detect::RunnerOptions ro;
   ro.backend = backend;
   ro.threads = threads;
-  detect::CenternetNetwork network(detect::cached_model_json("centernet"), ro);
+  // CenterNet as the strategy ran it: squeezed to 512 x 512, or at the frame's aspect.
+  std::unique_ptr<detect::CenternetNetwork> network;
+  const auto network_for = [&](const ImageBuffer& frame) -> detect::CenternetNetwork& {
+    const auto [height, width] =
+        o.detector_aspect && o.detector_tiles == 1
+            ? detect::centernet_input_at_aspect(frame.width(), frame.height())
+            : std::pair{detect::kCenternetInput, detect::kCenternetInput};
+    if (!network || network->input_height() != height || network->input_width() != width)
+      network = std::make_unique<detect::CenternetNetwork>(detect::cached_model_json("centernet"),
+                                                           height, width, ro);
+    return *network;
+  };
   detect::SinglePoseNetwork pose(o.pose_model,
                                  detect::cached_model_json(detect::model_name(o.pose_model)), ro);
   const detect::ProposalOptions used{o.min_box_score, o.box_overlap, o.detector_tiles,
@@ -380,7 +462,7 @@ void diagnose(const std::string& input, const eval::DetectionTruth& truth, const
         it == r.people.end() ? std::vector<Box2D>{} : boxes(it->second);
     const auto score = eval::score_frame(*t, found, min_iou);
     const std::vector<detect::Detection> proposed =
-        detect::propose_people(network, *f, low, scratch);
+        detect::propose_people(network_for(*f), *f, low, scratch);
     std::vector<Box2D> kept;
     for (const auto& d : proposed)
       if (d.score >= used.min_score) kept.push_back(d.box);
@@ -469,12 +551,12 @@ void diagnose(const std::string& input, const eval::DetectionTruth& truth, const
           count("(c1) proposed, crop's keypoints rejected");
           rejected_score[static_cast<std::size_t>(
               std::clamp(static_cast<int>(verdict.score * 10), 0, 4))]++;
-        } else if (!posed) {
-          count("(c3) proposed, person dropped (duplicate) or not looked for");
-        } else if (detect::iou(detect::keypoint_box(points, 0.12f), box) < 0.3f) {
+        } else if (posed && detect::iou(detect::keypoint_box(points, 0.12f), box) < 0.3f) {
           count("(c2) proposed, crop's keypoints on someone else");
         } else {
-          count("(c3) proposed, person dropped (duplicate) or not looked for");
+          const auto trace = r.traces.find(i);
+          count(trace == r.traces.end() ? "(c3) proposed, no trace of the frame"
+                                        : dropped_by(trace->second, box));
         }
       }
     }
@@ -564,7 +646,7 @@ int main(int argc, char** argv) {
           "multipose:SIZE, "
           "tiles:CxR:TILE:FRAME, "
           "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:kEVERY][:"
-          "uSURE][:bPRESENCE][:m0][:h1][:cH[xP]][:aIOU] "
+          "uSURE][:bPRESENCE][:m0][:h1][:cH[xP]][:aIOU][:oOKS][:n1][:x1][:r1] "
           "(MODEL: lightning, thunder, blazepose-lite, blazepose-full, blazepose-heavy; "
           "workers: copies of the keypoint network sharing a frame's crops; tTILES: person "
           "detector tiles, tTILESw: and the whole frame, sSCORE: its box score floor, uSURE: "
@@ -574,7 +656,12 @@ int main(int argc, char** argv) {
           "picture (before the anatomical margins), h1: BlazePose's head margin at least 0.54 x "
           "the eyes' height above the shoulders, cH[xP]: boxes under H px get crops of "
           "padding P (default 1.5), aIOU: a newcomer is a person only when its posed box overlaps "
-          "the detector's by this IoU, kEVERY: keypoint pass every "
+          "the detector's by this IoU, oOKS: finds sharing 3 keypoints are one person only at this "
+          "keypoint similarity (COCO OKS; 0.9: HRNet's), n1: a followed person is at most one "
+          "detector box (others overlapping them get crops), "
+          "x1: a followed box over 2+ detector boxes is split into them, "
+          "r1: CenterNet sees the frame at its aspect "
+          "(512 x 896 for 16:9) instead of squeezed to 512 x 512, kEVERY: keypoint pass every "
           "EVERY "
           "frames, optical flow between; a top-down "
           "strategy also prints where its time went)",
@@ -627,7 +714,7 @@ int main(int argc, char** argv) {
         for (const std::string& runtime : split(args.get("backends"), ',')) {
           const detect::Backend backend = detect::resolve_backend(detect::parse_backend(runtime));
           Strategy s = make_strategy(spec, backend, threads);
-          runs.push_back(run(s, input, only));
+          runs.push_back(run(s, input, only, at));
           topdowns.push_back(s.topdown);
           backends.push_back(backend);
           names.push_back(spec + "@" + std::string(detect::backend_name(backend)));

@@ -40,6 +40,20 @@ class TopDownNode : public Node {
     c.param<bool>("detector_whole_frame", false,
                   "with detector_tiles > 1, one more detector pass on the whole frame for people "
                   "wider than the tiles' overlap (close-ups), merged by NMS");
+    c.param<bool>("detector_aspect", false,
+                  "with detector_tiles 1, the person detector sees the frame at its own aspect "
+                  "(512 x 896 for 16:9) instead of squeezed to 512 x 512");
+    c.param<bool>("one_box_per_followed", false,
+                  "on a detector run a followed person is at most one box; another box "
+                  "overlapping them gets its own crop (two people followed as one box)");
+    c.param<bool>("split_followed", false,
+                  "on a detector run a followed person whose box overlaps two detector boxes or "
+                  "more is that many people, each cropped from their box");
+    c.param<double>("duplicate_similarity", 0.0,
+                    "two finds sharing 3 keypoints are one person only at this keypoint "
+                    "similarity (COCO OKS; 0.9: HRNet's), whatever their boxes' overlap; 0: "
+                    "box overlap 0.6 or the same keypoints",
+                    {0.0, 1.0});
     c.param<double>("sure_box_score", 0.0,
                     "a person box the detector scores this high is a person even when the crop's "
                     "keypoints fail the person test (only the confident keypoints kept); 0: off",
@@ -86,6 +100,10 @@ class TopDownNode : public Node {
     o.min_box_score = ctx.param<float>("min_box_score");
     o.detector_tiles = ctx.param<int>("detector_tiles");
     o.detector_whole_frame = ctx.param<bool>("detector_whole_frame");
+    o.detector_aspect = ctx.param<bool>("detector_aspect");
+    o.one_box_per_followed = ctx.param<bool>("one_box_per_followed");
+    o.split_followed = ctx.param<bool>("split_followed");
+    o.duplicate_similarity = ctx.param<float>("duplicate_similarity");
     o.sure_box_score = ctx.param<float>("sure_box_score");
     o.min_person_score = ctx.param<float>("min_person_score");
     o.min_keypoints = ctx.param<int>("min_keypoints");
