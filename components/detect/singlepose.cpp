@@ -214,16 +214,19 @@ const std::vector<GraphTensor>& SinglePoseNetwork::run_heads(const GraphTensor& 
   return heads_;
 }
 
-std::vector<SinglePose> SinglePoseNetwork::run(const GraphTensor& crops) {
+std::vector<SinglePose> SinglePoseNetwork::run(const GraphTensor& crops, int largest_pass) {
   const int batch = crops.shape.empty() ? 0 : static_cast<int>(crops.shape[0]);
   std::vector<SinglePose> out(static_cast<std::size_t>(std::max(batch, 0)));
-  run(crops, 0, batch, out);
+  run(crops, 0, batch, out, largest_pass);
   return out;
 }
 
 void SinglePoseNetwork::run(const GraphTensor& crops, int first, int count,
-                            std::span<SinglePose> out) {
-  constexpr int kLargestPass = 8;
+                            std::span<SinglePose> out, int largest_pass) {
+  if (largest_pass < 1 || largest_pass > kMaxPass || (largest_pass & (largest_pass - 1)) != 0)
+    throw std::invalid_argument(std::string(model_name(model_)) +
+                                ": the largest pass must be 1, 2, 4 or 8 crops, not " +
+                                std::to_string(largest_pass));
   if (crops.shape.size() != 4 || crops.values.size() != crops.size())
     throw std::invalid_argument(std::string(model_name(model_)) + ": malformed crop batch");
   const int batch = static_cast<int>(crops.shape[0]);
@@ -234,7 +237,7 @@ void SinglePoseNetwork::run(const GraphTensor& crops, int first, int count,
                                 " outside the batch of " + std::to_string(batch));
   const std::size_t per_crop = batch > 0 ? crops.size() / static_cast<std::size_t>(batch) : 0;
   for (int done = 0; done < count;) {
-    int pass = kLargestPass;
+    int pass = largest_pass;
     while (pass > count - done) pass /= 2;
     pass_.shape = crops.shape;
     pass_.shape[0] = pass;

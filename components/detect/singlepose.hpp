@@ -99,12 +99,16 @@ class SinglePoseNetwork {
   // MediaPipe and @vladmandic/human feed it): landmarks [N, 1, 1, 195], pose flag [N, 1, 1, 1].
   // Valid until the next call.
   const std::vector<GraphTensor>& run_heads(const GraphTensor& crops);
-  // The keypoints of every crop of the batch, run in passes of 8, 4, 2 and 1 crops: the XNNPACK
-  // runtime builds itself per input shape (about 0.3 s) and keeps the last 4, so whatever the
-  // number of people, these four shapes are all it ever builds.
-  std::vector<SinglePose> run(const GraphTensor& crops);
+  // The keypoints of every crop of the batch, run in passes of `largest_pass`, its halves ... 1
+  // crops (8: 8, 4, 2, 1): the XNNPACK runtime builds itself per input shape (about 0.3 s) and
+  // keeps the last 4, so whatever the number of people, these shapes are all it ever builds. A
+  // crop's keypoints do not depend on the pass it is in (tests/detect/detect_golden_test.cpp).
+  std::vector<SinglePose> run(const GraphTensor& crops, int largest_pass = kLargestPass);
   // The same for crops [first, first + count) of the batch, written to out[0, count).
-  void run(const GraphTensor& crops, int first, int count, std::span<SinglePose> out);
+  void run(const GraphTensor& crops, int first, int count, std::span<SinglePose> out,
+           int largest_pass = kLargestPass);
+  // The largest pass by default; a power of two up to kMaxPass.
+  static constexpr int kLargestPass = 8, kMaxPass = 8;
 
  private:
   SinglePoseModel model_;

@@ -41,6 +41,9 @@ void check(const TopDownOptions& o) {
       !(o.small_crop_padding >= 1.0f && o.small_crop_padding <= 4.0f))
     throw std::invalid_argument("small_box_height must be >= 0 and small_crop_padding in [1, 4]");
   if (o.workers < 1 || o.workers > 16) throw std::invalid_argument("workers must lie in [1, 16]");
+  if (o.crops_per_pass < 1 || o.crops_per_pass > SinglePoseNetwork::kMaxPass ||
+      (o.crops_per_pass & (o.crops_per_pass - 1)) != 0)
+    throw std::invalid_argument("crops_per_pass must be 1, 2, 4 or 8");
   if (o.keypoint_every < 1) throw std::invalid_argument("keypoint_every must be at least 1");
   if (!(o.followed_overlap > 0.0f && o.followed_overlap < 1.0f))
     throw std::invalid_argument("followed_overlap must lie in (0, 1)");
@@ -238,10 +241,11 @@ void TopDownDetector::warm_up() {
   // With detector_aspect the network for the frame's aspect is made on the first frame.
   image_batch(image_, 1, boxes_->input_height(), boxes_->input_width());
   boxes_->run(image_);
-  // The shapes SinglePoseNetwork::run passes: 8, 4, 2 and 1 crops, on every copy.
+  // The shapes SinglePoseNetwork::run passes: crops_per_pass, its halves, ... 1 crops, on every
+  // copy.
   const int copies = static_cast<int>(poses_.size());
   const int size = poses_.front()->input_size();
-  for (const int pass : {8, 4, 2, 1}) {
+  for (int pass = options_.crops_per_pass; pass >= 1; pass /= 2) {
     image_batch(crops_, pass * copies, size, size);
     found_.resize(static_cast<std::size_t>(pass * copies));
     run_keypoints(0, pass * copies, copies);
@@ -275,7 +279,8 @@ void TopDownDetector::run_keypoints(int first, int count, int copies) {
   const auto share = [&](int c) {
     const int begin = count * c / copies, end = count * (c + 1) / copies;
     poses_[static_cast<std::size_t>(c)]->run(crops_, begin, end - begin,
-                                             out.subspan(static_cast<std::size_t>(begin)));
+                                             out.subspan(static_cast<std::size_t>(begin)),
+                                             options_.crops_per_pass);
   };
   for (int c = 1; c < copies; ++c)
     helpers_->submit([&share, c](int) {

@@ -119,6 +119,11 @@ struct TopDownOptions {
   // Copies of the keypoint network, each on its own thread (the calling thread runs the first);
   // with more than one, `threads` 0 means 1 per copy.
   int workers = 1;
+  // Crops per forward pass of the keypoint network at most (1, 2, 4 or 8): a frame's crops go in
+  // passes of this, its halves, ... 1. The people found do not depend on it; the time does
+  // (smaller passes keep a pass's activations in the core's cache: measured in
+  // docs/detection-strategies.md, "Both cores for the file default").
+  int crops_per_pass = 2;
   // A followed person's keypoints come from the keypoint network every keypoint_every frames
   // (1: every frame) and are carried by optical flow in between: a keypoint's flow counts when
   // flowed back it lands within max(1 px, flow_error x the person's box height) of where it

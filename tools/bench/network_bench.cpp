@@ -1,13 +1,17 @@
 // mocap-bench-networks: the 2D networks' forward time per model, input size, runtime (cv::dnn,
 // XNNPACK) and thread count, all configurations in one run, interleaved round by round so that
 // the machine's load hits them alike. Input: a window of a real frame resized to the network's
-// input. Prints a Markdown table of medians (and the first run, which builds the runtime). The
-// detection strategies built from these networks are measured by mocap-bench-detect.
+// input. Prints a Markdown table of medians (and the first run, which builds the runtime).
+// BlazePose's landmark models (the top-down crops) also run several crops per forward
+// (--batches: detect.topdown's crops_per_pass), timed per crop in wall and in this thread's CPU
+// time (which the other processes of a shared machine disturb less). The detection strategies
+// built from these networks are measured by mocap-bench-detect.
 
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
 #include <iostream>
 #include <memory>
 #include <sstream>
@@ -71,12 +75,25 @@ struct Config {
   std::string model, input;
   Backend backend = Backend::opencv;
   int threads = 1;
+  int batch = 1;  // images per forward
   std::unique_ptr<GraphRunner> runner;
   std::vector<std::int64_t> shape;
   std::vector<float> values;
   double first_ms = 0;
-  std::vector<double> times;
+  std::vector<double> times, cpu_times;  // per forward
 };
+
+// This thread's CPU time in ms.
+double thread_cpu_ms() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) * 1e3 + static_cast<double>(t.tv_nsec) * 1e-6;
+}
+
+// BlazePose's landmark models, which detect.topdown feeds in batches of crops and which take a
+// batch at their placeholder (MoveNet single-pose takes one only after its batch-of-one
+// reshuffles: detect::SinglePoseNetwork).
+bool takes_batches(const std::string& model) { return model.starts_with("blazepose"); }
 
 double ms_since(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
@@ -142,7 +159,9 @@ int main(int argc, char** argv) {
       .option("backends", "LIST", "runtimes: opencv, xnnpack", "opencv,xnnpack")
       .option("threads", "LIST", "thread counts", "1,2")
       .option("rounds", "N", "rounds over all configurations", "6")
-      .option("per-round", "N", "timed forwards per configuration and round", "5");
+      .option("per-round", "N", "timed forwards per configuration and round", "5")
+      .option("batches", "LIST",
+              "crops per forward of BlazePose's landmark models (the others run one image)", "1");
   int exit_code = 0;
   if (!args.parse(argc - 1, argv + 1, exit_code)) return exit_code;
   try {
@@ -157,26 +176,31 @@ int main(int argc, char** argv) {
       const auto json = model_cache_dir() / model / (model + ".json");
       for (const auto& [w, h] : sizes(model, args.get("multipose-sizes"))) {
         for (const auto& backend : list(args.get("backends"))) {
-          for (const auto& threads : list(args.get("threads"))) {
-            Config c;
-            c.model = model;
-            c.input = std::to_string(w) + "x" + std::to_string(h);
-            c.backend = parse_backend(backend);
-            c.threads = std::stoi(threads);
-            RunnerOptions options;
-            options.backend = c.backend;
-            options.threads = c.threads;
-            try {
-              c.runner = make_graph_runner(json, net->outputs, options);
-            } catch (const std::exception& e) {
-              std::cerr << model << " " << backend << ": not run: " << e.what() << "\n";
-              continue;
+          for (const auto& threads : list(args.get("threads")))
+            for (const auto& batch :
+                 takes_batches(model) ? list(args.get("batches")) : std::vector<std::string>{"1"}) {
+              Config c;
+              c.batch = std::stoi(batch);
+              c.model = model;
+              c.input = std::to_string(w) + "x" + std::to_string(h);
+              c.backend = parse_backend(backend);
+              c.threads = std::stoi(threads);
+              RunnerOptions options;
+              options.backend = c.backend;
+              options.threads = c.threads;
+              try {
+                c.runner = make_graph_runner(json, net->outputs, options);
+              } catch (const std::exception& e) {
+                std::cerr << model << " " << backend << ": not run: " << e.what() << "\n";
+                continue;
+              }
+              c.shape = net->nchw ? std::vector<std::int64_t>{1, 3, h, w}
+                                  : std::vector<std::int64_t>{c.batch, h, w, 3};
+              const std::vector<float> image = input_values(rgb, w, h, *net);
+              for (int i = 0; i < c.batch; ++i)
+                c.values.insert(c.values.end(), image.begin(), image.end());
+              configs.push_back(std::move(c));
             }
-            c.shape = net->nchw ? std::vector<std::int64_t>{1, 3, h, w}
-                                : std::vector<std::int64_t>{1, h, w, 3};
-            c.values = input_values(rgb, w, h, *net);
-            configs.push_back(std::move(c));
-          }
         }
       }
     }
@@ -195,7 +219,9 @@ int main(int argc, char** argv) {
       for (Config& c : configs) {
         for (long i = 0; i < per_round; ++i) {
           const auto start = Clock::now();
+          const double cpu = thread_cpu_ms();
           run_once(c, outputs);
+          c.cpu_times.push_back(thread_cpu_ms() - cpu);
           c.times.push_back(ms_since(start));
         }
       }
@@ -205,19 +231,21 @@ int main(int argc, char** argv) {
     std::printf("\n%ld rounds x %ld forwards per configuration, interleaved\n\n", rounds,
                 per_round);
     std::printf(
-        "| model | input (WxH) | runtime | threads | median ms | p90 ms | min ms | first run ms | "
-        "cv::dnn / this (same threads) |\n");
-    std::printf("|---|---|---|---|---|---|---|---|---|\n");
+        "| model | input (WxH) | runtime | threads | batch | median ms | p90 ms | min ms | first "
+        "run ms | median ms per image | CPU ms per image (median) | cv::dnn / this (same "
+        "threads and batch) |\n");
+    std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|\n");
     for (const Config& c : configs) {
       const double median = percentile(c.times, 0.5);
       double ratio = 0;
       for (const Config& o : configs)
         if (o.model == c.model && o.input == c.input && o.threads == c.threads &&
-            o.backend == Backend::opencv)
+            o.batch == c.batch && o.backend == Backend::opencv)
           ratio = percentile(o.times, 0.5) / median;
-      std::printf("| %s | %s | %s | %d | %.1f | %.1f | %.1f | %.0f | %s |\n", c.model.c_str(),
-                  c.input.c_str(), std::string(backend_name(c.backend)).c_str(), c.threads, median,
-                  percentile(c.times, 0.9), percentile(c.times, 0.0), c.first_ms,
+      std::printf("| %s | %s | %s | %d | %d | %.1f | %.1f | %.1f | %.0f | %.1f | %.1f | %s |\n",
+                  c.model.c_str(), c.input.c_str(), std::string(backend_name(c.backend)).c_str(),
+                  c.threads, c.batch, median, percentile(c.times, 0.9), percentile(c.times, 0.0),
+                  c.first_ms, median / c.batch, percentile(c.cpu_times, 0.5) / c.batch,
                   ratio > 0 ? (std::to_string(ratio).substr(0, 4) + "x").c_str() : "-");
     }
   } catch (const std::exception& e) {

@@ -144,7 +144,13 @@ void configure_video(graph::GraphSpec& spec, const Args& args, const VideoInfo& 
   }
   set_param(spec, "sink.overlay", "canvas_width", width);
   set_param(spec, "sink.overlay", "canvas_height", height);
-  if (!info.live) read_frames_in_overlay(spec, args.positionals()[0]);
+  if (!info.live) {
+    read_frames_in_overlay(spec, args.positionals()[0]);
+    // A file waits for nobody: the top-down networks build the batch shapes they meet as they
+    // meet them instead of every shape up front (measured in docs/detection-strategies.md,
+    // "Both cores for the file default").
+    set_param(spec, "detect.topdown", "warm_up", "false");
+  }
 }
 
 bool is_detector(const std::string& type) {

@@ -79,13 +79,18 @@ class TopDownNode : public Node {
                  "thread (2: both cores); the person detector then runs beside the followed "
                  "people's crops",
                  {1, 16});
+    c.param<int>("crops_per_pass", 2,
+                 "crops per forward pass of the keypoint network at most (1, 2, 4 or 8); the "
+                 "people found do not depend on it, the time does (2: measured fastest)",
+                 {1, 8});
     c.param<int>("keypoint_every", 1,
                  "live: a person's keypoint pass every N frames, carried by optical flow between "
                  "(a person whose flow fails gets a pass at once); 1: every frame",
                  {1, 100});
     c.param<bool>("warm_up", true,
                   "build the networks for every batch shape when the node opens, so that a live "
-                  "source's first frames are not late");
+                  "source's first frames are not late (mocap reconstruct turns it off for files: "
+                  "the shapes are then built as they are met)");
     c.param<std::string>("pose_model_file", "", "model.json (empty: the cache)");
     c.param<std::string>("box_model_file", "", "CenterNet model.json (empty: the cache)");
   }
@@ -114,6 +119,7 @@ class TopDownNode : public Node {
     o.threads = network.threads;
     o.workers = ctx.param<int>("workers");
     o.keypoint_every = ctx.param<int>("keypoint_every");
+    o.crops_per_pass = ctx.param<int>("crops_per_pass");
     detector_.emplace(o, model_file(ctx, "pose_model_file", detect::model_name(o.pose_model)),
                       model_file(ctx, "box_model_file", "centernet"));
     std::cerr << "node '" << ctx.node_name() << "': top-down on "
