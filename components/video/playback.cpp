@@ -25,7 +25,8 @@ Playback::Playback(std::string path, SourceOptions source_options, PlaybackOptio
       paced_(live_ && !source_.live()),
       loop_(options.loop && !source_.live()),
       frame_offset_(options.frame_offset),
-      reconnect_ms_(options.reconnect_ms) {}
+      reconnect_ms_(options.reconnect_ms),
+      replay_fps_(options.replay_fps) {}
 
 std::string Playback::describe() const {
   std::ostringstream text;
@@ -36,6 +37,7 @@ std::string Playback::describe() const {
   else
     text << "unknown";
   text << " frames, " << (live_ ? "live" : "offline");
+  if (paced_ && replay_fps_ > 0) text << " replayed at " << replay_fps_ << " fps";
   if (source_options_.decoder_threads > 0 && !decoder_threads_supported())
     text << " (decoder_threads ignored: this OpenCV's FFmpeg backend decodes with one thread per "
             "core; OpenCV 4.7 can set it)";
@@ -54,6 +56,10 @@ std::string Playback::describe_losses() const {
 
 double Playback::frame_period_s() const {
   return source_.fps() > 0 ? 1.0 / source_.fps() : 1.0 / 30.0;
+}
+
+double Playback::pace_period_s() const {
+  return replay_fps_ > 0 ? 1.0 / replay_fps_ : frame_period_s();
 }
 
 std::optional<StampedFrame> Playback::next(const WaitUntil& wait) {
@@ -157,7 +163,7 @@ std::string Playback::status() const {
 
 std::optional<Frame> Playback::paced_read(const WaitUntil& wait) {
   if (pace_start_ns_ == 0) pace_start_ns_ = realtime_now_ns();
-  const double period = frame_period_s();
+  const double period = pace_period_s();
   for (;;) {
     const double due_s = static_cast<double>(source_.frames_read()) * period;
     const double late_s = static_cast<double>(realtime_now_ns() - pace_start_ns_) * 1e-9 - due_s;

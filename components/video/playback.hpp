@@ -36,6 +36,9 @@ struct PlaybackOptions {
   // Network streams read live: a stream that stops is opened again this often until it answers;
   // 0: its stop is its end.
   int reconnect_ms = 1000;
+  // Files and folders read live: paced at this rate instead of their own (a 10 fps clip replayed
+  // as a 25 fps camera, to measure a live pipeline at a camera's rate); 0: their own rate.
+  double replay_fps = 0.0;
 };
 
 struct StampedFrame {
@@ -89,6 +92,7 @@ class Playback {
   void lose_stream();
   bool reconnect(const WaitUntil& wait);  // false while the stream is not back (or stopped)
   double frame_period_s() const;
+  double pace_period_s() const;  // between paced frames: replay_fps's, else frame_period_s()
   void add_news(const std::string& text);
 
   std::string path_;
@@ -100,6 +104,7 @@ class Playback {
   double pass_offset_s_ = 0.0, last_media_time_s_ = 0.0;
   std::uint64_t late_ = 0, undecodable_ = 0, passes_ = 0;
   int reconnect_ms_ = 0;
+  double replay_fps_ = 0.0;
   std::int64_t lost_since_ns_ = 0, next_attempt_ns_ = 0;  // while a stream is lost
   std::int64_t index_base_ = 0;  // frames of the connections before this one
   std::uint64_t reconnects_ = 0, losses_ = 0, attempts_ = 0;

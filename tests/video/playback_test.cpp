@@ -1,6 +1,7 @@
 // video::Playback: a looped folder goes on stamping where the previous pass ended; a paced folder
 // is stamped with the times its frames were due, passes over the frames a slow reader is late for,
-// and a wait cut short (a stop) is not taken for the end; a frame offset shifts indices and stamps.
+// and a wait cut short (a stop) is not taken for the end; a frame offset shifts indices and stamps;
+// a replay rate paces a file or folder at a camera's rate instead of its own.
 
 #include "video/playback.hpp"
 
@@ -98,6 +99,18 @@ TEST(Playback, APacedFolderIsStampedWhenItsFramesAreDue) {
   ASSERT_EQ(stamps.size(), 4u);
   for (std::size_t i = 1; i < stamps.size(); ++i) EXPECT_EQ(stamps[i] - stamps[i - 1], 100 * kMs);
   EXPECT_EQ(playback.late_frames_passed_over(), 0u);
+}
+
+// replay_fps: a 10 fps folder replayed as a 25 fps camera is due every 40 ms, and says so.
+TEST(Playback, AReplayRatePacesAFolderInsteadOfItsOwnRate) {
+  const test::TempDir dir;
+  Playback playback(image_folder(dir, 4), at_fps(10.0), {.live = true, .replay_fps = 25.0});
+  EXPECT_NE(playback.describe().find("replayed at 25 fps"), std::string::npos)
+      << playback.describe();
+  std::vector<std::int64_t> stamps;
+  while (auto frame = playback.next(sleep_until)) stamps.push_back(frame->stamp_ns);
+  ASSERT_EQ(stamps.size(), 4u);
+  for (std::size_t i = 1; i < stamps.size(); ++i) EXPECT_EQ(stamps[i] - stamps[i - 1], 40 * kMs);
 }
 
 TEST(Playback, APacedFolderPassesOverTheFramesASlowReaderIsLateFor) {

@@ -176,6 +176,7 @@ struct RunSpec {
   int workers = 1;
   int lag = 8;
   bool print_stats = false;  // the runtime's per-node table (queues, waits) to stderr
+  double replay_fps = 0;     // live runs: the file paced at this rate (0: its own)
 };
 
 std::string detector_node(const RunSpec& s) {
@@ -198,7 +199,9 @@ std::string graph_text(const RunSpec& s, const video::VideoSource& info, const s
   std::ostringstream g;
   g << "graph: bench_video\nnodes:\n"
     << "  src: { type: source.video, params: { path: \"" << s.video
-    << "\", mode: " << (s.live ? "live" : "offline") << " } }\n"
+    << "\", mode: " << (s.live ? "live" : "offline")
+    << (s.live && s.replay_fps > 0 ? ", replay_fps: " + std::to_string(s.replay_fps) : "")
+    << " } }\n"
     << "  det: " << detector_node(s) << "\n"
     << "  track: { type: recon.tracker }\n"
     << "  scale: { type: recon.scaler, params: { db: \"" << s.db << "\" } }\n"
@@ -343,6 +346,10 @@ int main(int argc, char** argv) {
               "the same for live runs: it holds each frame until N more have been detected, i.e. "
               "N x the detector's period (docs/detection-strategies.md, 2026-11-26)",
               "0")
+      .option("replay-fps", "F",
+              "live runs: the file replayed at F frames/s instead of its own rate (a 10 fps clip "
+              "as a 25 fps camera); 0: its own",
+              "0")
       .flag("stats",
             "print each run's per-node statistics to stderr (queue depth, how long messages "
             "waited in each node's inputs, time blocked on a full queue downstream)")
@@ -385,6 +392,7 @@ int main(int argc, char** argv) {
           spec.detector_threads = std::stoi(threads);
           spec.lag = std::stoi(args.get(spec.live ? "live-lag" : "lag"));
           spec.print_stats = args.has("stats");
+          spec.replay_fps = args.number("replay-fps");
           spec.out_dir = args.get("out") + "/" + std::filesystem::path(video).stem().string() +
                          "_" + label + "_" + backend + "_w" + workers + "_t" + threads + "_" +
                          mode + "_lag" + std::to_string(spec.lag);

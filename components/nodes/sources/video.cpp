@@ -46,6 +46,9 @@ class VideoSourceNode : public Node {
                           "the scene's frame i + frame_offset: views without a common clock)",
                           {-1e6, 1e6});
     c.param<bool>("loop", false, "files and folders: start again at the end (counts the passes)");
+    c.param<double>("replay_fps", 0.0,
+                    "files and folders read live: paced at this rate instead of their own (0)",
+                    {0.0, 1000.0});
   }
 
   void open(Context& ctx) override {
@@ -61,7 +64,8 @@ class VideoSourceNode : public Node {
     video::PlaybackOptions playback{.live = {},
                                     .loop = ctx.param<bool>("loop"),
                                     .frame_offset = ctx.param<std::int64_t>("frame_offset"),
-                                    .reconnect_ms = ctx.param<int>("reconnect_ms")};
+                                    .reconnect_ms = ctx.param<int>("reconnect_ms"),
+                                    .replay_fps = ctx.param<double>("replay_fps")};
     if (mode != "auto") playback.live = mode == "live";
     playback_.emplace(path, options, playback);
     count_ = ctx.param<std::uint64_t>("count");
