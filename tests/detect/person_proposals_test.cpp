@@ -17,6 +17,7 @@
 #include "detect/image_tensor.hpp"
 #include "detect/model_files.hpp"
 #include "detect/person_proposals.hpp"
+#include "found_again.hpp"
 #include "support/images.hpp"
 
 namespace mocap::detect {
@@ -112,9 +113,8 @@ TEST_F(PersonProposals, CenternetAtTheFramesAspectFindsWhatTheSqueezedFrameFinds
   low.min_score = 0.3f;  // scores move with the scale; the boxes must be there
   const auto found = propose_people(at_aspect, frame, low, input);
   for (const Detection& s : squeezed) {
-    const bool again = std::any_of(found.begin(), found.end(),
-                                   [&](const Detection& d) { return iou(s.box, d.box) > 0.5f; });
-    EXPECT_TRUE(again) << "a person at x " << s.box.x << ", y " << s.box.y << " lost at aspect";
+    EXPECT_TRUE(test::found_again(s.box, found))
+        << "a person at x " << s.box.x << ", y " << s.box.y << " lost at aspect";
   }
   ProposalOptions tiled;
   tiled.tiles = 2;
@@ -133,9 +133,8 @@ TEST_F(PersonProposals, TilesFindThePeopleTheStretchedFrameFinds) {
   tiled.tiles = 2;
   const auto found = propose(tiled);
   for (const Detection& s : stretched) {
-    bool again = false;
-    for (const Detection& t : found) again = again || iou(s.box, t.box) > 0.5f;
-    EXPECT_TRUE(again) << "a person at x " << s.box.x << ", y " << s.box.y << " lost on the tiles";
+    EXPECT_TRUE(test::found_again(s.box, found))
+        << "a person at x " << s.box.x << ", y " << s.box.y << " lost on the tiles";
   }
   for (const Detection& t : found) {  // boxes in frame pixels, best first
     EXPECT_GE(t.score, tiled.min_score);

@@ -21,6 +21,7 @@
 #include "detect/model_files.hpp"
 #include "detect/person_proposals.hpp"
 #include "detect/topdown_detector.hpp"
+#include "found_again.hpp"
 #include "support/images.hpp"
 
 namespace mocap::detect {
@@ -330,10 +331,8 @@ TEST(TopDownDetector, BlazePoseFindsThePedestriansOfFrame300) {
     }
     // The same people as MoveNet's: each of Lightning's finds has a BlazePose find on it.
     for (const MovenetPerson& r : reference) {
-      const bool same = std::any_of(people.begin(), people.end(), [&](const MovenetPerson& p) {
-        return iou(p.box, r.box) > 0.5f;
-      });
-      EXPECT_TRUE(same) << "Lightning's person at x " << r.box.x << " not found by BlazePose";
+      EXPECT_TRUE(test::found_again(r.box, people))
+          << "Lightning's person at x " << r.box.x << " not found by BlazePose";
     }
   }
 }
@@ -372,10 +371,8 @@ TEST(TopDownDetector, TheRulesForPeopleAsOneBoxKeepThePeopleFoundApart) {
     SCOPED_TRACE(f);
     EXPECT_GE(plain.people[f].size(), 3u);
     for (const MovenetPerson& p : plain.people[f]) {
-      const bool again =
-          std::any_of(ruled.people[f].begin(), ruled.people[f].end(),
-                      [&](const MovenetPerson& q) { return iou(p.box, q.box) > 0.5f; });
-      EXPECT_TRUE(again) << "the person at x " << p.box.x << " lost";
+      EXPECT_TRUE(test::found_again(p.box, ruled.people[f]))
+          << "the person at x " << p.box.x << " lost";
     }
   }
   o.duplicate_similarity = 1.5f;
