@@ -103,7 +103,7 @@ Strategy make_strategy(const std::string& spec, detect::Backend backend, int thr
     } catch (const std::invalid_argument&) {
       throw std::invalid_argument(
           "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:kEVERY][:uSURE][:"
-          "bPRESENCE][:m0][:h1][:cH[xP]][:aIOU][:oOKS][:n1][:x1][:r1] with "
+          "bPRESENCE][:m0][:h1][:cH[xP]][:aIOU][:oOKS][:n1][:x1][:r1][:g1] with "
           "MODEL " +
           std::string(detect::pose_model_names()) + ", got " + spec);
     }
@@ -112,7 +112,8 @@ Strategy make_strategy(const std::string& spec, detect::Backend backend, int thr
     // frame), sX (its score threshold), kK (keypoint pass every K frames), uX (sure_box_score) and
     // bX (box_landmark_presence), m0 (the landmark box widened as the keypoints', not cut to the
     // picture: anatomical_landmark_box off), h1 (head_margin_from_shoulders), cH[xP] (boxes under
-    // H px cropped with padding P: small_box_height, small_crop_padding).
+    // H px cropped with padding P: small_box_height, small_crop_padding), g1 (the person detector
+    // in the background: detector_in_background; its runs end as the bench's pace allows).
     std::vector<std::string> numbers;
     for (std::size_t i = 3; i < parts.size(); ++i) {
       if (parts[i].size() > 1 && parts[i][0] == 't') {
@@ -136,6 +137,8 @@ Strategy make_strategy(const std::string& spec, detect::Backend backend, int thr
         o.split_followed = true;
       else if (parts[i] == "r1")
         o.detector_aspect = true;
+      else if (parts[i] == "g1")
+        o.detector_in_background = true;
       else if (parts[i] == "h1")
         o.head_margin_from_shoulders = true;
       else if (parts[i].size() > 1 && parts[i][0] == 'c') {
@@ -151,7 +154,7 @@ Strategy make_strategy(const std::string& spec, detect::Backend backend, int thr
     if (numbers.size() > 2)
       throw std::invalid_argument(
           "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:kEVERY][:uSURE][:"
-          "bPRESENCE][:m0][:h1][:cH[xP]][:aIOU][:oOKS][:n1][:x1][:r1], got " +
+          "bPRESENCE][:m0][:h1][:cH[xP]][:aIOU][:oOKS][:n1][:x1][:r1][:g1], got " +
           spec);
     o.backend = backend;
     o.threads = numbers.size() == 2 ? std::stoi(numbers[1]) : threads;
@@ -171,7 +174,7 @@ Strategy make_strategy(const std::string& spec, detect::Backend backend, int thr
       "unknown strategy '" + spec +
       "' (multipose:SIZE, tiles:CxR:TILE:FRAME, "
       "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:"
-      "kEVERY][:uSURE][:bPRESENCE][:m0][:h1][:cH[xP]][:aIOU][:oOKS][:n1][:x1][:r1])");
+      "kEVERY][:uSURE][:bPRESENCE][:m0][:h1][:cH[xP]][:aIOU][:oOKS][:n1][:x1][:r1][:g1])");
 }
 
 // Every frame of a video, or the one image of a still.
@@ -209,6 +212,7 @@ struct Run {
   std::map<int, People> people;  // every frame
   double seconds = 0;
   int frames = 0;
+  std::vector<double> frame_ms;                // detect() per timed frame, wall clock
   detect::TopDownProfile profile;              // of the timed frames (top-down only)
   std::map<int, detect::TopDownTrace> traces;  // top-down only: the frames in `keep_traces`
 };
@@ -241,7 +245,9 @@ Run run(Strategy& s, const std::string& input, const std::vector<int>& only,
     auto f = frames.next();
     if (!f) break;
     if (!only.empty() && !std::binary_search(only.begin(), only.end(), i)) continue;
+    const auto detecting = Clock::now();
     r.people[i] = s.detect(*f);
+    r.frame_ms.push_back(1e3 * std::chrono::duration<double>(Clock::now() - detecting).count());
     if (s.topdown && std::binary_search(keep_traces.begin(), keep_traces.end(), i))
       r.traces[i] = s.trace();
     ++r.frames;
@@ -607,18 +613,25 @@ void print_profiles(const std::vector<std::string>& names, const std::vector<Run
     if (p.frames == 0) continue;
     if (!header)
       std::printf(
-          "\n| top-down strategy | crops/frame | detector runs | ms/frame: detect() | "
+          "\n| top-down strategy | crops/frame | detector runs | ms/frame: detect() (p50 / p95 / "
+          "max) | "
           "CenterNet (per run; on the caller) | crop cutting | keypoint passes (per crop) | "
           "optical flow | rest | carried by flow /frame (flow failed) |\n"
           "|---|---|---|---|---|---|---|---|---|---|\n");
     header = true;
     const double f = static_cast<double>(p.frames);
     const double rest = p.total - p.centernet_wait - p.crop_fill - p.keypoints - p.flow;
+    std::vector<double> ms = runs[s].frame_ms;
+    std::sort(ms.begin(), ms.end());
+    const auto at = [&ms](double q) {
+      return ms.empty() ? 0.0
+                        : ms[static_cast<std::size_t>(q * static_cast<double>(ms.size() - 1))];
+    };
     std::printf(
-        "| %s | %.2f | %lld | %.1f | %.1f (%.1f; %.1f waited) | %.1f | %.1f (%.2f) | %.1f | %.1f "
-        "| %.2f (%lld) |\n",
+        "| %s | %.2f | %lld | %.1f (%.1f / %.1f / %.1f) | %.1f (%.1f; %.1f waited) | %.1f | %.1f "
+        "(%.2f) | %.1f | %.1f | %.2f (%lld) |\n",
         names[s].c_str(), static_cast<double>(p.crops) / f, p.detector_runs, 1e3 * p.total / f,
-        1e3 * p.centernet / f,
+        at(0.5), at(0.95), at(1.0), 1e3 * p.centernet / f,
         p.detector_runs ? 1e3 * p.centernet / static_cast<double>(p.detector_runs) : 0.0,
         1e3 * p.centernet_wait / f, 1e3 * p.crop_fill / f, 1e3 * p.keypoints / f,
         p.crops ? 1e3 * p.keypoints / static_cast<double>(p.crops) : 0.0, 1e3 * p.flow / f,
@@ -646,7 +659,7 @@ int main(int argc, char** argv) {
           "multipose:SIZE, "
           "tiles:CxR:TILE:FRAME, "
           "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:kEVERY][:"
-          "uSURE][:bPRESENCE][:m0][:h1][:cH[xP]][:aIOU][:oOKS][:n1][:x1][:r1] "
+          "uSURE][:bPRESENCE][:m0][:h1][:cH[xP]][:aIOU][:oOKS][:n1][:x1][:r1][:g1] "
           "(MODEL: lightning, thunder, blazepose-lite, blazepose-full, blazepose-heavy; "
           "workers: copies of the keypoint network sharing a frame's crops; tTILES: person "
           "detector tiles, tTILESw: and the whole frame, sSCORE: its box score floor, uSURE: "
@@ -663,8 +676,8 @@ int main(int argc, char** argv) {
           "r1: CenterNet sees the frame at its aspect "
           "(512 x 896 for 16:9) instead of squeezed to 512 x 512, kEVERY: keypoint pass every "
           "EVERY "
-          "frames, optical flow between; a top-down "
-          "strategy also prints where its time went)",
+          "frames, optical flow between, g1: the person detector in the background (no frame "
+          "waits for it; live); a top-down strategy also prints where its time went)",
           "topdown:thunder:1,multipose:256,multipose:512,tiles:2x2:256:256,"
           "topdown:lightning:1,topdown:lightning:10,topdown:thunder:10")
       .option("truth", "DIR", "hand-checked boxes", "tests/data/detection")
