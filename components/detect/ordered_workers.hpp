@@ -57,6 +57,15 @@ class OrderedWorkers {
   // Submitted jobs whose results were not taken yet.
   std::size_t pending() const { return order_.size(); }
 
+  // Waits until the oldest job is done, leaving its result to next() (returns at once when nothing
+  // is pending).
+  void wait_oldest() {
+    if (order_.empty()) return;
+    std::unique_lock lock(mutex_);
+    const std::shared_ptr<Slot> slot = order_.front();
+    job_done_.wait(lock, [&] { return slot->done; });
+  }
+
   // The oldest job's result once it is done: waits for it when `wait`, else returns nothing when
   // it is still running (or nothing is pending). Rethrows what the job threw.
   std::optional<Result> next(bool wait) {

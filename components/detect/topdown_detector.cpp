@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <exception>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -83,6 +85,18 @@ void join(OrderedWorkers<int>& helpers, int count, std::exception_ptr error) {
     }
   }
   if (error) std::rethrow_exception(error);
+}
+
+// `image` with its own tightly packed copy of the pixels.
+ImageBuffer packed_copy(const ImageBuffer& image) {
+  ImageBuffer copy(image.width(), image.height(), image.format());
+  const std::size_t row = static_cast<std::size_t>(image.width()) *
+                          static_cast<std::size_t>(bytes_per_pixel(image.format()));
+  std::byte* to = copy.pixels_for_writing().data();
+  for (int y = 0; y < image.height(); ++y)
+    std::memcpy(to + row * static_cast<std::size_t>(y),
+                image.data() + static_cast<std::size_t>(image.stride()) * y, row);
+  return copy;
 }
 
 }  // namespace
@@ -226,18 +240,30 @@ TopDownDetector::TopDownDetector(const TopDownOptions& options,
                                                          runner_options(options_)));
   if (options_.workers > 1) helpers_ = std::make_unique<OrderedWorkers<int>>(options_.workers - 1);
   if (options_.keypoint_every > 1) flow_ = std::make_unique<KeypointFlow>();
+  if (options_.detector_in_background)
+    background_ = std::make_unique<OrderedWorkers<BackgroundBoxes>>(1);
 }
 
 TopDownDetector::~TopDownDetector() = default;
 
 void TopDownDetector::reset() {
+  // A background run on the last video's frame is forgotten, whatever became of it.
+  if (background_ && background_->pending() > 0) {
+    background_->wait_oldest();
+    try {
+      background_->next(false);
+    } catch (...) {
+    }
+  }
   followed_.clear();
   frame_ = 0;
+  detector_started_ = 0;
   lost_someone_ = false;
   if (flow_) flow_->reset();
 }
 
 void TopDownDetector::warm_up() {
+  wait_for_detector();  // it uses the person detector's network and input
   // With detector_aspect the network for the frame's aspect is made on the first frame.
   image_batch(image_, 1, boxes_->input_height(), boxes_->input_width());
   boxes_->run(image_);
@@ -253,8 +279,7 @@ void TopDownDetector::warm_up() {
   found_.clear();
 }
 
-std::vector<Detection> TopDownDetector::find_boxes(const ImageBuffer& frame) {
-  const auto start = Clock::now();
+std::vector<Detection> TopDownDetector::propose(const ImageBuffer& frame) {
   if (options_.detector_aspect && options_.detector_tiles == 1) {
     // The network for this frame's aspect (made again only when the frame's shape changes).
     const auto [height, width] = centernet_input_at_aspect(frame.width(), frame.height());
@@ -262,14 +287,73 @@ std::vector<Detection> TopDownDetector::find_boxes(const ImageBuffer& frame) {
       boxes_ = std::make_unique<CenternetNetwork>(centernet_json_, height, width,
                                                   runner_options(options_));
   }
-  std::vector<Detection> found =
-      propose_people(*boxes_, frame,
-                     {options_.min_box_score, options_.box_overlap, options_.detector_tiles,
-                      options_.detector_whole_frame},
-                     image_);
+  return propose_people(*boxes_, frame,
+                        {options_.min_box_score, options_.box_overlap, options_.detector_tiles,
+                         options_.detector_whole_frame},
+                        image_);
+}
+
+std::vector<Detection> TopDownDetector::find_boxes(const ImageBuffer& frame) {
+  const auto start = Clock::now();
+  std::vector<Detection> found = propose(frame);
   ++profile_.detector_runs;
   profile_.centernet += seconds_since(start);
   return found;
+}
+
+std::size_t TopDownDetector::find_boxes_beside_crops(const ImageBuffer& frame,
+                                                     std::span<const Box2D> boxes,
+                                                     std::vector<Detection>& detections) {
+  if (!helpers_) {
+    const auto running = Clock::now();
+    detections = find_boxes(frame);
+    profile_.centernet_wait += seconds_since(running);
+    return 0;
+  }
+  // The person detector on a helper, the followed people's crops here meanwhile.
+  helpers_->submit([&](int) {
+    detections = find_boxes(frame);
+    return 0;
+  });
+  std::exception_ptr error;
+  try {
+    add_crops(frame, boxes, 1);
+  } catch (...) {
+    error = std::current_exception();
+  }
+  const auto waiting = Clock::now();
+  join(*helpers_, 1, error);
+  profile_.centernet_wait += seconds_since(waiting);
+  return boxes.size();
+}
+
+void TopDownDetector::start_detector(const ImageBuffer& frame) {
+  // A copy: the caller may reuse the frame's memory while the run goes on.
+  auto copy = std::make_shared<ImageBuffer>(packed_copy(frame));
+  background_->submit([this, copy](int) {
+    const auto start = Clock::now();
+    BackgroundBoxes run{propose(*copy), 0};
+    run.seconds = seconds_since(start);
+    return run;
+  });
+  detector_started_ = frame_;
+}
+
+bool TopDownDetector::finished_detector(std::vector<Detection>& detections) {
+  if (!background_) return false;
+  std::optional<BackgroundBoxes> run = background_->next(false);
+  if (!run) return false;
+  detections = std::move(run->detections);
+  ++profile_.detector_runs;
+  profile_.centernet += run->seconds;
+  return true;
+}
+
+void TopDownDetector::wait_for_detector() {
+  if (!background_ || background_->pending() == 0) return;
+  const auto waiting = Clock::now();
+  background_->wait_oldest();
+  profile_.centernet_wait += seconds_since(waiting);
 }
 
 void TopDownDetector::run_keypoints(int first, int count, int copies) {
@@ -420,6 +504,97 @@ void TopDownDetector::record_crops(const std::vector<Found>& found,
   }
 }
 
+void TopDownDetector::take_detections(const std::vector<Detection>& detections,
+                                      std::size_t followed, const std::vector<Found>& found,
+                                      std::vector<Box2D>& boxes) {
+  if (options_.split_followed) {
+    // A followed box over two detector boxes or more is that many people: their crop is set
+    // aside (its box empty, overlapping nothing) and each box becomes a newcomer.
+    for (std::size_t i = 0; i < followed; ++i) {
+      const auto over = std::count_if(detections.begin(), detections.end(), [&](const auto& d) {
+        return iou(boxes[i], d.box) > options_.followed_overlap;
+      });
+      if (over >= 2) split_[i] = 1;
+    }
+  }
+  std::vector<Box2D> claimants(boxes.begin(),
+                               boxes.begin() + static_cast<std::ptrdiff_t>(followed));
+  for (std::size_t i = 0; i < followed; ++i)
+    if (split_[i]) claimants[i] = {};
+  const std::vector<int> owner = followed_boxes(claimants, detections, options_.followed_overlap,
+                                                options_.one_box_per_followed);
+  // A followed person's detector score is the best of the boxes that are them (0: none): with
+  // one_box_per_followed their own box's, else that of every box overlapping them.
+  for (std::size_t i = 0; i < followed; ++i) {
+    box_scores_[i] = 0;
+    for (std::size_t d = 0; d < detections.size(); ++d)
+      if (options_.one_box_per_followed
+              ? owner[d] == static_cast<int>(i)
+              : iou(claimants[i], detections[d].box) > options_.followed_overlap)
+        box_scores_[i] = std::max(box_scores_[i], detections[d].score);
+  }
+  trace_.detections = detections;
+  for (std::size_t d = 0; d < detections.size(); ++d) {
+    const Box2D& box = detections[d].box;
+    const bool carried = std::any_of(found.begin(), found.end(), [&](const Found& c) {
+      return iou(c.person.box, box) > options_.followed_overlap;
+    });
+    trace_.taken_for.push_back(owner[d] >= 0 ? owner[d] : carried ? -2 : -1);
+    if (owner[d] < 0 && !carried) {
+      boxes.push_back(box);
+      box_scores_.push_back(detections[d].score);
+      newcomer_.push_back(1);
+      split_.push_back(0);
+    }
+  }
+}
+
+std::vector<TopDownDetector::Followed> TopDownDetector::follow(
+    const std::vector<MovenetPerson>& people, const std::vector<Found>& found,
+    const std::vector<std::size_t>& kept) const {
+  std::vector<Followed> next;
+  for (std::size_t i = 0; i < people.size(); ++i) {
+    const MovenetPerson& p = people[i];
+    const Found& found_p = found[kept[i]];
+    Followed f{found_p.follow, 0, 0, p, found_p.carried, found_p.box_score};
+    const float cx = f.box.x + f.box.width / 2, cy = f.box.y + f.box.height / 2;
+    float best = 0.3f;  // the predecessor must overlap the person this much
+    for (const Followed& old : followed_) {
+      const Box2D predicted = moved(old.box, old.vx, old.vy);
+      const float overlap = iou(predicted, f.box);
+      if (overlap <= best) continue;
+      best = overlap;
+      // Smoothed: half the new displacement, half the old motion.
+      f.vx = 0.5f * (cx - (old.box.x + old.box.width / 2)) + 0.5f * old.vx;
+      f.vy = 0.5f * (cy - (old.box.y + old.box.height / 2)) + 0.5f * old.vy;
+    }
+    next.push_back(f);
+  }
+  spread_keypoint_passes(next);
+  return next;
+}
+
+void TopDownDetector::spread_keypoint_passes(std::vector<Followed>& next) const {
+  const int every = options_.keypoint_every;
+  if (every <= 1) return;
+  // due[d]: the people whose next keypoint pass is d + 1 frames away (carried c: every - c).
+  std::vector<int> due(static_cast<std::size_t>(every), 0);
+  const auto slot = [every](int carried) {
+    return static_cast<std::size_t>(every - 1 - std::min(carried, every - 1));
+  };
+  for (const Followed& f : next)
+    if (f.carried > 0) ++due[slot(f.carried)];
+  for (Followed& f : next) {
+    if (f.carried != 0) continue;
+    // A whole carry (the last slot) unless a sooner pass is due for fewer people.
+    std::size_t best = due.size() - 1;
+    for (std::size_t d = best; d-- > 0;)
+      if (due[d] < due[best]) best = d;
+    f.carried = every - 1 - static_cast<int>(best);
+    ++due[best];
+  }
+}
+
 std::vector<MovenetPerson> TopDownDetector::detect(const ImageBuffer& frame) {
   const auto start = Clock::now();
   if (flow_) {
@@ -441,83 +616,20 @@ std::vector<MovenetPerson> TopDownDetector::detect(const ImageBuffer& frame) {
     newcomer_.push_back(0);
     split_.push_back(0);
   }
-  const bool run_detector =
-      frame_ % options_.detect_every == 0 || lost_someone_ || followed_.empty();
-  trace_.detector_ran = run_detector;
+  const bool background = options_.detector_in_background;
+  const bool due = frame_ % options_.detect_every == 0 || lost_someone_ || followed_.empty();
   trace_.detections.clear();
   trace_.taken_for.clear();
-  ++frame_;
   regions_.clear();
   crop_boxes_.clear();
   found_.clear();
-  const int copies = static_cast<int>(poses_.size());
+  std::vector<Detection> detections;
   std::size_t cropped = 0;  // boxes whose keypoints are found
-  if (run_detector) {
-    std::vector<Detection> detections;
-    if (helpers_) {
-      // The person detector on a helper, the followed people's crops here meanwhile.
-      helpers_->submit([&](int) {
-        detections = find_boxes(frame);
-        return 0;
-      });
-      std::exception_ptr error;
-      try {
-        add_crops(frame, boxes, 1);
-      } catch (...) {
-        error = std::current_exception();
-      }
-      const auto waiting = Clock::now();
-      join(*helpers_, 1, error);
-      profile_.centernet_wait += seconds_since(waiting);
-      cropped = boxes.size();
-    } else {
-      const auto running = Clock::now();
-      detections = find_boxes(frame);
-      profile_.centernet_wait += seconds_since(running);
-    }
-    const std::size_t followed = boxes.size();
-    if (options_.split_followed) {
-      // A followed box over two detector boxes or more is that many people: their crop is set
-      // aside (its box empty, overlapping nothing) and each box becomes a newcomer.
-      for (std::size_t i = 0; i < followed; ++i) {
-        const auto over = std::count_if(detections.begin(), detections.end(), [&](const auto& d) {
-          return iou(boxes[i], d.box) > options_.followed_overlap;
-        });
-        if (over >= 2) split_[i] = 1;
-      }
-    }
-    std::vector<Box2D> claimants(boxes.begin(),
-                                 boxes.begin() + static_cast<std::ptrdiff_t>(followed));
-    for (std::size_t i = 0; i < followed; ++i)
-      if (split_[i]) claimants[i] = {};
-    const std::vector<int> owner = followed_boxes(claimants, detections, options_.followed_overlap,
-                                                  options_.one_box_per_followed);
-    // A followed person's detector score is the best of the boxes that are them (0: none): with
-    // one_box_per_followed their own box's, else that of every box overlapping them.
-    for (std::size_t i = 0; i < followed; ++i) {
-      box_scores_[i] = 0;
-      for (std::size_t d = 0; d < detections.size(); ++d)
-        if (options_.one_box_per_followed
-                ? owner[d] == static_cast<int>(i)
-                : iou(claimants[i], detections[d].box) > options_.followed_overlap)
-          box_scores_[i] = std::max(box_scores_[i], detections[d].score);
-    }
-    trace_.detections = detections;
-    for (std::size_t d = 0; d < detections.size(); ++d) {
-      const Box2D& box = detections[d].box;
-      const bool carried = std::any_of(found.begin(), found.end(), [&](const Found& c) {
-        return iou(c.person.box, box) > options_.followed_overlap;
-      });
-      trace_.taken_for.push_back(owner[d] >= 0 ? owner[d] : carried ? -2 : -1);
-      if (owner[d] < 0 && !carried) {
-        boxes.push_back(box);
-        box_scores_.push_back(detections[d].score);
-        newcomer_.push_back(1);
-        split_.push_back(0);
-      }
-    }
-  }
-  add_crops(frame, std::span<const Box2D>(boxes).subspan(cropped), copies);
+  const bool detector_ran = background ? finished_detector(detections) : due;
+  if (detector_ran && !background) cropped = find_boxes_beside_crops(frame, boxes, detections);
+  trace_.detector_ran = detector_ran;
+  if (detector_ran) take_detections(detections, boxes.size(), found, boxes);
+  add_crops(frame, std::span<const Box2D>(boxes).subspan(cropped), static_cast<int>(poses_.size()));
   people_found(frame, found);
   std::vector<MovenetPerson> people;
   std::vector<std::size_t> kept;  // per person: their index in `found`
@@ -535,28 +647,19 @@ std::vector<MovenetPerson> TopDownDetector::detect(const ImageBuffer& frame) {
     for (const std::size_t i : kept) people.push_back(found[i].person);
     record_crops(found, why);
   }
-
-  // The next frame's crops: each person's box, moved by how far their nearest predecessor moved.
-  std::vector<Followed> next;
-  for (std::size_t i = 0; i < people.size(); ++i) {
-    const MovenetPerson& p = people[i];
-    const Found& found_p = found[kept[i]];
-    Followed f{found_p.follow, 0, 0, p, found_p.carried, found_p.box_score};
-    const float cx = f.box.x + f.box.width / 2, cy = f.box.y + f.box.height / 2;
-    float best = 0.3f;  // the predecessor must overlap the person this much
-    for (const Followed& old : followed_) {
-      const Box2D predicted = moved(old.box, old.vx, old.vy);
-      const float overlap = iou(predicted, f.box);
-      if (overlap <= best) continue;
-      best = overlap;
-      // Smoothed: half the new displacement, half the old motion.
-      f.vx = 0.5f * (cx - (old.box.x + old.box.width / 2)) + 0.5f * old.vx;
-      f.vy = 0.5f * (cy - (old.box.y + old.box.height / 2)) + 0.5f * old.vy;
-    }
-    next.push_back(f);
-  }
-  lost_someone_ = next.size() < followed_.size() && !run_detector;
+  std::vector<Followed> next = follow(people, found, kept);
+  // In the background a loss waits for the run going on to end (its boxes were taken before it).
+  lost_someone_ =
+      (background && lost_someone_) || (next.size() < followed_.size() && !detector_ran);
   followed_ = std::move(next);
+  ++frame_;
+  // In the background a run starts when none is going on, detect_every frames after the last
+  // one started, after a frame that lost somebody, or while nobody is followed.
+  if (background && background_->pending() == 0 &&
+      (frame_ - detector_started_ >= options_.detect_every || lost_someone_ || followed_.empty())) {
+    start_detector(frame);
+    lost_someone_ = false;
+  }
   ++profile_.frames;
   profile_.crops += static_cast<long long>(boxes.size());
   profile_.total += seconds_since(start);

@@ -132,6 +132,14 @@ struct TopDownOptions {
   // keypoint pass instead.
   int keypoint_every = 1;
   float flow_error = 0.03f;
+  // Live: the person detector runs on a thread of its own, on a copy of the frame it was due on,
+  // while the frames go on with the people already followed; its boxes are taken in on the first
+  // frame after the run ends (never the frame that started it), as on a detector frame. A frame
+  // then never waits for the detector (a run costs several frame periods of a 25 fps camera),
+  // at the price of newcomers found a few frames later from boxes a few frames old (the crop's
+  // padding absorbs that motion). What is found then depends on timing: off for files. Runs
+  // start every detect_every frames and after a frame that lost somebody, when none is running.
+  bool detector_in_background = false;
 };
 
 // The person test of one crop's answer: MoveNet's keypoints (at least min_keypoints scoring
@@ -240,6 +248,9 @@ class TopDownDetector {
   std::vector<MovenetPerson> detect(const ImageBuffer& frame);
   // Forget the people followed so far (a new video).
   void reset();
+  // With detector_in_background: waits for the person detector's run in progress, if any; the
+  // next detect() takes its boxes in.
+  void wait_for_detector();
   // Runs both networks once on blank inputs of every shape they will get (XNNPACK builds a
   // runtime per shape, about 0.3 s each), so that a live source's first frames are not late.
   void warm_up();
@@ -272,7 +283,33 @@ class TopDownDetector {
     bool posed = true;
     int crop = -1;  // the crop of the frame it came from (-1: carried by optical flow)
   };
+  // The person detector on `frame` (uses boxes_ and image_: one caller at a time).
+  std::vector<Detection> propose(const ImageBuffer& frame);
+  // propose(), timed into the profile.
   std::vector<Detection> find_boxes(const ImageBuffer& frame);
+  // The detector's boxes of this frame, found beside the crops of the people followed (`boxes`,
+  // cut meanwhile when there are helpers): how many of `boxes` were cropped.
+  std::size_t find_boxes_beside_crops(const ImageBuffer& frame, std::span<const Box2D> boxes,
+                                      std::vector<Detection>& detections);
+  // detector_in_background: starts a run on a copy of `frame`; takes a finished run's boxes
+  // into `detections` (false when none finished since the last call).
+  void start_detector(const ImageBuffer& frame);
+  bool finished_detector(std::vector<Detection>& detections);
+  // The detector's boxes against the people followed (`boxes`' first `followed`, their crops'
+  // boxes; `found`, those carried by flow): the detector scores of the followed, and a crop box
+  // appended to `boxes` for every newcomer.
+  void take_detections(const std::vector<Detection>& detections, std::size_t followed,
+                       const std::vector<Found>& found, std::vector<Box2D>& boxes);
+  // The next frame's followed people: each person kept, moved by how far their nearest
+  // predecessor moved.
+  std::vector<Followed> follow(const std::vector<MovenetPerson>& people,
+                               const std::vector<Found>& found,
+                               const std::vector<std::size_t>& kept) const;
+  // With keypoint_every K: the people posed on this frame are spread over the next K frames'
+  // keypoint passes, each to the frame the fewest are due on (a sooner pass, never a later one),
+  // so that a frame's passes stay about people / K instead of every person's at once every K
+  // frames after a detector run (a live frame that long is late and the source's next dropped).
+  void spread_keypoint_passes(std::vector<Followed>& next) const;
   // Keypoints of a crop for each box, appended to found_ (regions_ gets their squares), the
   // crops shared by the first `copies` copies of the keypoint network.
   // box_scores_ holds, per box of the frame, the detector's score of it.
@@ -305,9 +342,17 @@ class TopDownDetector {
   std::vector<float> flow_limit_, flow_dx_, flow_dy_;
   std::vector<std::uint8_t> flow_ok_, carried_;
   long long frame_ = 0;
+  long long detector_started_ = 0;  // the frame its last background run started on
   bool lost_someone_ = false;
   TopDownProfile profile_;
   TopDownTrace trace_;
+  // The background person detector (detector_in_background): its run's boxes and seconds. Last,
+  // so that it is stopped (its run finished) before what the run uses is destroyed.
+  struct BackgroundBoxes {
+    std::vector<Detection> detections;
+    double seconds = 0;
+  };
+  std::unique_ptr<OrderedWorkers<BackgroundBoxes>> background_;
 };
 
 }  // namespace mocap::detect

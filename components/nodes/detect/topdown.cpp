@@ -87,6 +87,10 @@ class TopDownNode : public Node {
                  "live: a person's keypoint pass every N frames, carried by optical flow between "
                  "(a person whose flow fails gets a pass at once); 1: every frame",
                  {1, 100});
+    c.param<bool>("detector_in_background", false,
+                  "live: the person detector runs on a thread of its own and no frame waits for "
+                  "it; newcomers are found a few frames later (what is found depends on timing: "
+                  "not for files)");
     c.param<bool>("warm_up", true,
                   "build the networks for every batch shape when the node opens, so that a live "
                   "source's first frames are not late (mocap reconstruct turns it off for files: "
@@ -120,6 +124,7 @@ class TopDownNode : public Node {
     o.workers = ctx.param<int>("workers");
     o.keypoint_every = ctx.param<int>("keypoint_every");
     o.crops_per_pass = ctx.param<int>("crops_per_pass");
+    o.detector_in_background = ctx.param<bool>("detector_in_background");
     detector_.emplace(o, model_file(ctx, "pose_model_file", detect::model_name(o.pose_model)),
                       model_file(ctx, "box_model_file", "centernet"));
     std::cerr << "node '" << ctx.node_name() << "': top-down on "
