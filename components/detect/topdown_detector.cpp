@@ -576,7 +576,7 @@ std::vector<TopDownDetector::Followed> TopDownDetector::follow(
 
 void TopDownDetector::spread_keypoint_passes(std::vector<Followed>& next) const {
   const int every = options_.keypoint_every;
-  if (every <= 1) return;
+  if (every <= 1 || !options_.spread_keypoint_passes) return;
   // due[d]: the people whose next keypoint pass is d + 1 frames away (carried c: every - c).
   std::vector<int> due(static_cast<std::size_t>(every), 0);
   const auto slot = [every](int carried) {

@@ -132,6 +132,9 @@ struct TopDownOptions {
   // keypoint pass instead.
   int keypoint_every = 1;
   float flow_error = 0.03f;
+  // With keypoint_every K > 1: the people posed on one frame get their next passes spread over
+  // the K frames after it (spread_keypoint_passes); false: all on the K-th (kept to measure).
+  bool spread_keypoint_passes = true;
   // Live: the person detector runs on a thread of its own, on a copy of the frame it was due on,
   // while the frames go on with the people already followed; its boxes are taken in on the first
   // frame after the run ends (never the frame that started it), as on a detector frame. A frame

@@ -103,7 +103,7 @@ Strategy make_strategy(const std::string& spec, detect::Backend backend, int thr
     } catch (const std::invalid_argument&) {
       throw std::invalid_argument(
           "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:kEVERY][:uSURE][:"
-          "bPRESENCE][:m0][:h1][:cH[xP]][:aIOU][:oOKS][:n1][:x1][:r1][:g1] with "
+          "bPRESENCE][:m0][:h1][:cH[xP]][:aIOU][:oOKS][:n1][:x1][:r1][:g1][:p0] with "
           "MODEL " +
           std::string(detect::pose_model_names()) + ", got " + spec);
     }
@@ -113,7 +113,8 @@ Strategy make_strategy(const std::string& spec, detect::Backend backend, int thr
     // bX (box_landmark_presence), m0 (the landmark box widened as the keypoints', not cut to the
     // picture: anatomical_landmark_box off), h1 (head_margin_from_shoulders), cH[xP] (boxes under
     // H px cropped with padding P: small_box_height, small_crop_padding), g1 (the person detector
-    // in the background: detector_in_background; its runs end as the bench's pace allows).
+    // in the background: detector_in_background; its runs end as the bench's pace allows), p0
+    // (spread_keypoint_passes off).
     std::vector<std::string> numbers;
     for (std::size_t i = 3; i < parts.size(); ++i) {
       if (parts[i].size() > 1 && parts[i][0] == 't') {
@@ -139,6 +140,8 @@ Strategy make_strategy(const std::string& spec, detect::Backend backend, int thr
         o.detector_aspect = true;
       else if (parts[i] == "g1")
         o.detector_in_background = true;
+      else if (parts[i] == "p0")
+        o.spread_keypoint_passes = false;
       else if (parts[i] == "h1")
         o.head_margin_from_shoulders = true;
       else if (parts[i].size() > 1 && parts[i][0] == 'c') {
@@ -154,7 +157,7 @@ Strategy make_strategy(const std::string& spec, detect::Backend backend, int thr
     if (numbers.size() > 2)
       throw std::invalid_argument(
           "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:kEVERY][:uSURE][:"
-          "bPRESENCE][:m0][:h1][:cH[xP]][:aIOU][:oOKS][:n1][:x1][:r1][:g1], got " +
+          "bPRESENCE][:m0][:h1][:cH[xP]][:aIOU][:oOKS][:n1][:x1][:r1][:g1][:p0], got " +
           spec);
     o.backend = backend;
     o.threads = numbers.size() == 2 ? std::stoi(numbers[1]) : threads;
@@ -174,7 +177,7 @@ Strategy make_strategy(const std::string& spec, detect::Backend backend, int thr
       "unknown strategy '" + spec +
       "' (multipose:SIZE, tiles:CxR:TILE:FRAME, "
       "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:"
-      "kEVERY][:uSURE][:bPRESENCE][:m0][:h1][:cH[xP]][:aIOU][:oOKS][:n1][:x1][:r1][:g1])");
+      "kEVERY][:uSURE][:bPRESENCE][:m0][:h1][:cH[xP]][:aIOU][:oOKS][:n1][:x1][:r1][:g1][:p0])");
 }
 
 // Every frame of a video, or the one image of a still.
@@ -659,7 +662,7 @@ int main(int argc, char** argv) {
           "multipose:SIZE, "
           "tiles:CxR:TILE:FRAME, "
           "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:kEVERY][:"
-          "uSURE][:bPRESENCE][:m0][:h1][:cH[xP]][:aIOU][:oOKS][:n1][:x1][:r1][:g1] "
+          "uSURE][:bPRESENCE][:m0][:h1][:cH[xP]][:aIOU][:oOKS][:n1][:x1][:r1][:g1][:p0] "
           "(MODEL: lightning, thunder, blazepose-lite, blazepose-full, blazepose-heavy; "
           "workers: copies of the keypoint network sharing a frame's crops; tTILES: person "
           "detector tiles, tTILESw: and the whole frame, sSCORE: its box score floor, uSURE: "
@@ -677,7 +680,8 @@ int main(int argc, char** argv) {
           "(512 x 896 for 16:9) instead of squeezed to 512 x 512, kEVERY: keypoint pass every "
           "EVERY "
           "frames, optical flow between, g1: the person detector in the background (no frame "
-          "waits for it; live); a top-down strategy also prints where its time went)",
+          "waits for it; live), p0: keypoint passes not spread over the frames between; a top-down "
+          "strategy also prints where its time went)",
           "topdown:thunder:1,multipose:256,multipose:512,tiles:2x2:256:256,"
           "topdown:lightning:1,topdown:lightning:10,topdown:thunder:10")
       .option("truth", "DIR", "hand-checked boxes", "tests/data/detection")

@@ -24,11 +24,15 @@ const DetectorPreset& detector_preset(std::string_view name);
 // BlazePose full in the crops (recall on video.avi 0.366 against 0.251 with MoveNet lightning, at
 // least as high on vtest.avi, vtest_part0 and the COCO stills, precision >= 0.95 on each;
 // 0.80-0.87x its frames/s end to end; graphs/monocular_video.yaml carries it). For a live source,
-// keep the rate: MultiPose 256, the only strategy measured to keep vtest's 10 frames/s live
-// (2026-11-26: top-down runs at 4-5 frames/s under the shared machine's load, topdown-flow at about
-// twice that but finds fewer people correctly). Each is a one-line change.
+// find people and keep the rate: top-down with keypoints carried by optical flow between passes
+// and the person detector in the background (vtest replayed at 25 fps: 4.8-4.9 people per frame
+// at 20-21 frames/s, against topdown-flow's 5.2 at 16-18 and MultiPose's 0.6 at 25; 2026-11-26).
+// Several live cameras keep MultiPose: a top-down detector per view on the same 2 cores (one
+// MultiPose pass per view was what the rig measurements ran, docs/cameras.md). Each is a one-line
+// change.
 inline constexpr std::string_view kFileDetector = "topdown-blaze";
-inline constexpr std::string_view kLiveDetector = "multipose";
+inline constexpr std::string_view kLiveDetector = "topdown-live";
+inline constexpr std::string_view kLiveMultiviewDetector = "multipose";
 
 // "a, b, c": the names, for help texts and errors.
 std::string detector_names();

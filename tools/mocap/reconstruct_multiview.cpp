@@ -504,8 +504,8 @@ int reconstruct_multiview_command(int argc, char** argv) {
               std::nullopt, Range::between(0.1, 1000.0))
       .option("detector", "NAME",
               "videos, image folders and cameras: how people are found: auto (" +
-                  std::string(kFileDetector) + " for files, " + std::string(kLiveDetector) +
-                  " for cameras, as without --calibration) or one of " + detector_names(),
+                  std::string(kFileDetector) + " for files, " + std::string(kLiveMultiviewDetector) +
+                  " for cameras: one detector per view) or one of " + detector_names(),
               "auto")
       .option("fit", "auto|off|live|full",
               "skeleton fit on all views (constant bone lengths per person, smooth, feet above "
@@ -561,7 +561,7 @@ int reconstruct_multiview_command(int argc, char** argv) {
     posedb::Database::open(args.get("db"));  // readable, before DIR is touched
   }
   std::string detector = args.get("detector");
-  if (detector == "auto") detector = std::string(live ? kLiveDetector : kFileDetector);
+  if (detector == "auto") detector = std::string(live ? kLiveMultiviewDetector : kFileDetector);
   if (live && args.has("offsets"))
     throw InputError("--offsets",
                      "cameras are joined by the time they took their frames: "
