@@ -27,8 +27,8 @@ const DetectorPreset& detector_preset(std::string_view name);
 // find people and keep the rate: top-down with keypoints carried by optical flow between passes
 // and the person detector in the background (vtest replayed at 25 fps: 4.8-4.9 people per frame
 // at 20-21 frames/s, against topdown-flow's 5.2 at 16-18 and MultiPose's 0.6 at 25; 2026-11-26).
-// Several live cameras keep MultiPose: a top-down detector per view on the same 2 cores (one
-// MultiPose pass per view was what the rig measurements ran, docs/cameras.md). Each is a one-line
+// Several live cameras keep MultiPose: each view runs its own detector on the same 2 cores, and
+// the multi-camera live runs were measured with it (topdown-live was not). Each is a one-line
 // change.
 inline constexpr std::string_view kFileDetector = "topdown-blaze";
 inline constexpr std::string_view kLiveDetector = "topdown-live";
