@@ -24,6 +24,7 @@
 #include <map>
 #include <memory>
 #include <sstream>
+#include <thread>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -215,7 +216,8 @@ struct Run {
   std::map<int, People> people;  // every frame
   double seconds = 0;
   int frames = 0;
-  std::vector<double> frame_ms;                // detect() per timed frame, wall clock
+  std::vector<double> frame_ms;  // detect() per timed frame, wall clock
+  int skipped = 0;  // --live-fps: frames a newer one replaced before the detector took them
   detect::TopDownProfile profile;              // of the timed frames (top-down only)
   std::map<int, detect::TopDownTrace> traces;  // top-down only: the frames in `keep_traces`
 };
@@ -230,9 +232,12 @@ detect::TopDownProfile minus(detect::TopDownProfile a, const detect::TopDownProf
 }
 
 // Every frame in order, or only those in `only` (sorted; empty: all); the top-down trace of the
-// frames in `keep_traces` (sorted) is kept.
+// frames in `keep_traces` (sorted) is kept. With `live_fps` > 0 the frames come as from a camera
+// at that rate: frame i exists from i / live_fps seconds on, the detector takes the newest frame
+// when it is free and the frames it had no time for are skipped (a `latest` edge); a skipped
+// frame's people are the last ones detected (what a live output shows at that moment).
 Run run(Strategy& s, const std::string& input, const std::vector<int>& only,
-        const std::vector<int>& keep_traces) {
+        const std::vector<int>& keep_traces, double live_fps) {
   Run r;
   {
     // cv::dnn sets its layers up on the first forward pass (several times a later one): done
@@ -244,12 +249,25 @@ Run run(Strategy& s, const std::string& input, const std::vector<int>& only,
   Frames frames(input);
   const detect::TopDownProfile before = s.profile();
   const auto start = Clock::now();
+  const auto captured = [&](int i) {
+    return start + std::chrono::duration_cast<Clock::duration>(
+                       std::chrono::duration<double>(i / std::max(live_fps, 1e-9)));
+  };
+  People last;
   for (int i = 0;; ++i) {
     auto f = frames.next();
     if (!f) break;
     if (!only.empty() && !std::binary_search(only.begin(), only.end(), i)) continue;
+    if (live_fps > 0) {
+      std::this_thread::sleep_until(captured(i));
+      if (Clock::now() >= captured(i + 1)) {  // frame i + 1 is there: i was replaced
+        r.people[i] = last;
+        ++r.skipped;
+        continue;
+      }
+    }
     const auto detecting = Clock::now();
-    r.people[i] = s.detect(*f);
+    r.people[i] = last = s.detect(*f);
     r.frame_ms.push_back(1e3 * std::chrono::duration<double>(Clock::now() - detecting).count());
     if (s.topdown && std::binary_search(keep_traces.begin(), keep_traces.end(), i))
       r.traces[i] = s.trace();
@@ -690,6 +708,9 @@ int main(int argc, char** argv) {
               "network runtimes, each strategy runs on each: auto, xnnpack, opencv", "auto")
       .option("threads", "N", "network threads (0: XNNPACK 1, cv::dnn OpenCV's default)", "0")
       .option("json", "FILE", "write every number here")
+      .option("live-fps", "F",
+              "frames come as from a camera at F frames/s: the detector takes the newest when "
+              "free, the others are skipped and show the last people found (live recall)")
       .flag("only-annotated",
             "detect on the annotated frames only (each one alone: no following between frames; "
             "quick, for making candidates)")
@@ -704,6 +725,7 @@ int main(int argc, char** argv) {
   if (!args.parse(argc - 1, argv + 1, exit_code)) return exit_code;
   try {
     const float min_iou = std::stof(args.get("iou"));
+    const double live_fps = args.has("live-fps") ? std::stod(args.get("live-fps")) : 0.0;
     const int threads = static_cast<int>(args.integer("threads"));
     json report = {{"iou", min_iou}, {"inputs", json::array()}};
     for (const std::string& input : split(args.get("inputs"), ',')) {
@@ -731,7 +753,7 @@ int main(int argc, char** argv) {
         for (const std::string& runtime : split(args.get("backends"), ',')) {
           const detect::Backend backend = detect::resolve_backend(detect::parse_backend(runtime));
           Strategy s = make_strategy(spec, backend, threads);
-          runs.push_back(run(s, input, only, at));
+          runs.push_back(run(s, input, only, at, live_fps));
           topdowns.push_back(s.topdown);
           backends.push_back(backend);
           names.push_back(spec + "@" + std::string(detect::backend_name(backend)));
@@ -775,7 +797,10 @@ int main(int argc, char** argv) {
         }
         const double recall = truths ? static_cast<double>(matched) / truths : std::nan("");
         const double precision = counted ? static_cast<double>(matched) / counted : std::nan("");
-        const double per_frame = static_cast<double>(people) / std::max(1, runs[s].frames);
+        // Per frame of the video (with --live-fps a skipped frame shows the last people found).
+        const double per_frame =
+            static_cast<double>(people) /
+            static_cast<double>(std::max<std::size_t>(1, runs[s].people.size()));
         const double fps = runs[s].frames / std::max(1e-9, runs[s].seconds);
         const double dist = median(distances);
         std::printf("| %s | %.3f | %.3f | %d | %.1f | %.2f | %.1f |\n", names[s].c_str(), recall,
@@ -790,6 +815,7 @@ int main(int argc, char** argv) {
                         {"people_per_frame", per_frame},
                         {"frames_per_second", fps},
                         {"frames", runs[s].frames},
+                        {"skipped_live", runs[s].skipped},
                         {"seconds", runs[s].seconds}});
       }
       // No cap on people (issue 18): how many frames show more than MultiPose's 6.
@@ -800,8 +826,11 @@ int main(int argc, char** argv) {
           crowded += found.size() > 6 ? 1 : 0;
           most = std::max(most, found.size());
         }
-        std::printf("%s%s: %d of %d frames with more than 6 people found (at most %zu)\n",
-                    s == 0 ? "\n" : "", names[s].c_str(), crowded, runs[s].frames, most);
+        std::printf("%s%s: %d of %d frames with more than 6 people found (at most %zu)%s\n",
+                    s == 0 ? "\n" : "", names[s].c_str(), crowded, runs[s].frames, most,
+                    live_fps > 0
+                        ? ("; " + std::to_string(runs[s].skipped) + " frames skipped live").c_str()
+                        : "");
       }
       print_profiles(names, runs);
       std::fflush(stdout);
