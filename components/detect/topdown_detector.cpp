@@ -258,6 +258,7 @@ void TopDownDetector::reset() {
   followed_.clear();
   frame_ = 0;
   detector_started_ = 0;
+  detector_frame_people_.clear();
   lost_someone_ = false;
   if (flow_) flow_->reset();
 }
@@ -337,6 +338,15 @@ void TopDownDetector::start_detector(const ImageBuffer& frame) {
     return run;
   });
   detector_started_ = frame_;
+  detector_frame_people_.clear();
+  for (const Followed& f : followed_) detector_frame_people_.emplace_back(f.id, f.box);
+}
+
+Box2D TopDownDetector::at_detector_frame(long long id, const Box2D& now) const {
+  if (!options_.detector_in_background) return now;
+  for (const auto& [seen, box] : detector_frame_people_)
+    if (seen == id) return box;
+  return now;
 }
 
 bool TopDownDetector::finished_detector(std::vector<Detection>& detections) {
@@ -425,7 +435,7 @@ void TopDownDetector::people_found(const ImageBuffer& frame, std::vector<Found>&
     person.box =
         posed ? posed_box(found_[i], r, options_, frame.width(), frame.height()) : crop_boxes_[i];
     const Box2D follow = posed ? posed_crop_box(found_[i], r, options_) : crop_boxes_[i];
-    found.push_back({person, follow, 0, box_score, posed, static_cast<int>(i)});
+    found.push_back({person, follow, 0, box_score, posed, static_cast<int>(i), box_ids_[i]});
   }
 }
 
@@ -479,7 +489,7 @@ void TopDownDetector::carry(std::vector<Found>& out) {
       ++p;
     }
     person.box = moved(person.box, dx, dy);
-    out.push_back({person, moved(f.box, dx, dy), f.carried + 1, f.box_score, true});
+    out.push_back({person, moved(f.box, dx, dy), f.carried + 1, f.box_score, true, -1, f.id});
     carried_[i] = 1;
     ++profile_.carried;
   }
@@ -517,10 +527,11 @@ void TopDownDetector::take_detections(const std::vector<Detection>& detections,
       if (over >= 2) split_[i] = 1;
     }
   }
-  std::vector<Box2D> claimants(boxes.begin(),
-                               boxes.begin() + static_cast<std::ptrdiff_t>(followed));
+  // A background run's boxes are of an earlier frame: they are compared with where the people
+  // followed were then (who has moved since is still themselves).
+  std::vector<Box2D> claimants;
   for (std::size_t i = 0; i < followed; ++i)
-    if (split_[i]) claimants[i] = {};
+    claimants.push_back(split_[i] ? Box2D{} : at_detector_frame(box_ids_[i], boxes[i]));
   const std::vector<int> owner = followed_boxes(claimants, detections, options_.followed_overlap,
                                                 options_.one_box_per_followed);
   // A followed person's detector score is the best of the boxes that are them (0: none): with
@@ -537,12 +548,13 @@ void TopDownDetector::take_detections(const std::vector<Detection>& detections,
   for (std::size_t d = 0; d < detections.size(); ++d) {
     const Box2D& box = detections[d].box;
     const bool carried = std::any_of(found.begin(), found.end(), [&](const Found& c) {
-      return iou(c.person.box, box) > options_.followed_overlap;
+      return iou(at_detector_frame(c.id, c.person.box), box) > options_.followed_overlap;
     });
     trace_.taken_for.push_back(owner[d] >= 0 ? owner[d] : carried ? -2 : -1);
     if (owner[d] < 0 && !carried) {
       boxes.push_back(box);
       box_scores_.push_back(detections[d].score);
+      box_ids_.push_back(-1);
       newcomer_.push_back(1);
       split_.push_back(0);
     }
@@ -551,12 +563,12 @@ void TopDownDetector::take_detections(const std::vector<Detection>& detections,
 
 std::vector<TopDownDetector::Followed> TopDownDetector::follow(
     const std::vector<MovenetPerson>& people, const std::vector<Found>& found,
-    const std::vector<std::size_t>& kept) const {
+    const std::vector<std::size_t>& kept) {
   std::vector<Followed> next;
   for (std::size_t i = 0; i < people.size(); ++i) {
     const MovenetPerson& p = people[i];
     const Found& found_p = found[kept[i]];
-    Followed f{found_p.follow, 0, 0, p, found_p.carried, found_p.box_score};
+    Followed f{found_p.follow, 0, 0, p, found_p.carried, found_p.box_score, found_p.id};
     const float cx = f.box.x + f.box.width / 2, cy = f.box.y + f.box.height / 2;
     float best = 0.3f;  // the predecessor must overlap the person this much
     for (const Followed& old : followed_) {
@@ -568,6 +580,7 @@ std::vector<TopDownDetector::Followed> TopDownDetector::follow(
       f.vx = 0.5f * (cx - (old.box.x + old.box.width / 2)) + 0.5f * old.vx;
       f.vy = 0.5f * (cy - (old.box.y + old.box.height / 2)) + 0.5f * old.vy;
     }
+    if (f.id < 0) f.id = next_id_++;  // a newcomer's crop: somebody not followed as such
     next.push_back(f);
   }
   spread_keypoint_passes(next);
@@ -607,16 +620,26 @@ std::vector<MovenetPerson> TopDownDetector::detect(const ImageBuffer& frame) {
   carry(found);
   std::vector<Box2D> boxes;
   box_scores_.clear();
+  box_ids_.clear();
   newcomer_.clear();
   split_.clear();
   for (std::size_t i = 0; i < followed_.size(); ++i) {
     if (carried_[i]) continue;
     boxes.push_back(moved(followed_[i].box, followed_[i].vx, followed_[i].vy));
     box_scores_.push_back(followed_[i].box_score);
+    box_ids_.push_back(followed_[i].id);
     newcomer_.push_back(0);
     split_.push_back(0);
   }
-  const bool background = options_.detector_in_background;
+  // In the background, a frame with nobody followed has nothing else to do: it waits for the run
+  // going on, or runs the person detector itself on its own picture.
+  bool background = options_.detector_in_background;
+  if (background && followed_.empty()) {
+    if (background_->pending() > 0)
+      wait_for_detector();
+    else
+      background = false, detector_started_ = frame_;
+  }
   const bool due = frame_ % options_.detect_every == 0 || lost_someone_ || followed_.empty();
   trace_.detections.clear();
   trace_.taken_for.clear();
@@ -654,9 +677,10 @@ std::vector<MovenetPerson> TopDownDetector::detect(const ImageBuffer& frame) {
   followed_ = std::move(next);
   ++frame_;
   // In the background a run starts when none is going on, detect_every frames after the last
-  // one started, after a frame that lost somebody, or while nobody is followed.
-  if (background && background_->pending() == 0 &&
-      (frame_ - detector_started_ >= options_.detect_every || lost_someone_ || followed_.empty())) {
+  // one started or after a frame that lost somebody (with nobody followed the next frame runs
+  // the detector itself).
+  if (options_.detector_in_background && background_->pending() == 0 && !followed_.empty() &&
+      (frame_ - detector_started_ >= options_.detect_every || lost_someone_)) {
     start_detector(frame);
     lost_someone_ = false;
   }

@@ -137,11 +137,13 @@ struct TopDownOptions {
   bool spread_keypoint_passes = true;
   // Live: the person detector runs on a thread of its own, on a copy of the frame it was due on,
   // while the frames go on with the people already followed; its boxes are taken in on the first
-  // frame after the run ends (never the frame that started it), as on a detector frame. A frame
-  // then never waits for the detector (a run costs several frame periods of a 25 fps camera),
-  // at the price of newcomers found a few frames later from boxes a few frames old (the crop's
-  // padding absorbs that motion). What is found then depends on timing: off for files. Runs
-  // start every detect_every frames and after a frame that lost somebody, when none is running.
+  // frame after the run ends, compared with where the people followed were on the run's frame.
+  // A frame with people to follow then never waits for the detector (a run costs several frame
+  // periods of a 25 fps camera), at the price of newcomers found a few frames later from boxes a
+  // few frames old (the crop's padding absorbs that motion). What is found depends on timing:
+  // off for files. Runs start every detect_every frames and after a frame that lost somebody,
+  // when none is running; a frame with nobody followed runs the detector itself (or waits for
+  // the run going on): it has nothing else to do.
   bool detector_in_background = false;
 };
 
@@ -274,6 +276,7 @@ class TopDownDetector {
     MovenetPerson person;  // their keypoints in the last frame
     int carried = 0;       // frames since their last keypoint pass
     float box_score = 0;   // the detector's score of them at its last run (0: not found by it)
+    long long id = -1;     // the same from frame to frame while they are followed
   };
   // A person found in this frame, how many frames their keypoints have been carried (0: a
   // keypoint pass), the detector's score of them, and whether their keypoints passed the person
@@ -284,7 +287,8 @@ class TopDownDetector {
     int carried = 0;
     float box_score = 0;
     bool posed = true;
-    int crop = -1;  // the crop of the frame it came from (-1: carried by optical flow)
+    int crop = -1;      // the crop of the frame it came from (-1: carried by optical flow)
+    long long id = -1;  // the followed person it continues (-1: a newcomer's crop)
   };
   // The person detector on `frame` (uses boxes_ and image_: one caller at a time).
   std::vector<Detection> propose(const ImageBuffer& frame);
@@ -303,11 +307,14 @@ class TopDownDetector {
   // appended to `boxes` for every newcomer.
   void take_detections(const std::vector<Detection>& detections, std::size_t followed,
                        const std::vector<Found>& found, std::vector<Box2D>& boxes);
+  // Where the followed person `id` was on the frame the background run looked at (their box
+  // then, which the run's boxes are compared with), else `now`.
+  Box2D at_detector_frame(long long id, const Box2D& now) const;
   // The next frame's followed people: each person kept, moved by how far their nearest
   // predecessor moved.
   std::vector<Followed> follow(const std::vector<MovenetPerson>& people,
                                const std::vector<Found>& found,
-                               const std::vector<std::size_t>& kept) const;
+                               const std::vector<std::size_t>& kept);
   // With keypoint_every K: the people posed on this frame are spread over the next K frames'
   // keypoint passes, each to the frame the fewest are due on (a sooner pass, never a later one),
   // so that a frame's passes stay about people / K instead of every person's at once every K
@@ -336,6 +343,7 @@ class TopDownDetector {
   std::vector<SquareRegion> regions_;
   std::vector<Box2D> crop_boxes_;       // per crop of the frame: the box it was cut around
   std::vector<float> box_scores_;       // per box of the frame: the detector's score of it
+  std::vector<long long> box_ids_;      // per box: the followed person's id (-1: a newcomer)
   std::vector<std::uint8_t> newcomer_;  // per box of the frame: a detector box nobody followed
   std::vector<std::uint8_t> split_;     // per box: a followed box split (split_followed)
   std::vector<SinglePose> found_;
@@ -346,6 +354,9 @@ class TopDownDetector {
   std::vector<std::uint8_t> flow_ok_, carried_;
   long long frame_ = 0;
   long long detector_started_ = 0;  // the frame its last background run started on
+  long long next_id_ = 0;
+  // The people followed on the frame the background run looks at: their ids and boxes.
+  std::vector<std::pair<long long, Box2D>> detector_frame_people_;
   bool lost_someone_ = false;
   TopDownProfile profile_;
   TopDownTrace trace_;
