@@ -25,8 +25,9 @@ const DetectorPreset& detector_preset(std::string_view name);
 // least as high on vtest.avi, vtest_part0 and the COCO stills, precision >= 0.95 on each;
 // 0.80-0.87x its frames/s end to end; graphs/monocular_video.yaml carries it). For a live source,
 // find people and keep the rate: top-down with keypoints carried by optical flow between passes
-// and the person detector in the background (vtest replayed at 25 fps: 4.8-4.9 people per frame
-// at 20-21 frames/s, against topdown-flow's 5.2 at 16-18 and MultiPose's 0.6 at 25; 2026-11-26).
+// and the person detector in the background (vtest replayed at 25 fps: 5.0-5.2 people per frame
+// at 21.5-24.3 frames/s, p95 111-188 ms, against topdown-flow's 5.2-5.3 at 17.6-18.4 and
+// MultiPose's 0.6 at 24.5-25; 2026-11-26).
 // Several live cameras keep MultiPose: each view runs its own detector on the same 2 cores, and
 // the multi-camera live runs were measured with it (topdown-live was not). Each is a one-line
 // change.
