@@ -635,10 +635,12 @@ std::vector<MovenetPerson> TopDownDetector::detect(const ImageBuffer& frame) {
   // going on, or runs the person detector itself on its own picture.
   bool background = options_.detector_in_background;
   if (background && followed_.empty()) {
-    if (background_->pending() > 0)
+    if (background_->pending() > 0) {
       wait_for_detector();
-    else
-      background = false, detector_started_ = frame_;
+    } else {
+      background = false;
+      detector_started_ = frame_;
+    }
   }
   const bool due = frame_ % options_.detect_every == 0 || lost_someone_ || followed_.empty();
   trace_.detections.clear();
