@@ -26,6 +26,7 @@ double seconds_since(Clock::time_point start) {
 
 void check(const TopDownOptions& o) {
   if (o.detect_every < 1) throw std::invalid_argument("detect_every must be at least 1");
+  if (o.rerun_gap < 0) throw std::invalid_argument("rerun_gap must be >= 0");
   if (!(o.crop_padding >= 1.0f && o.crop_padding <= 4.0f))
     throw std::invalid_argument("crop_padding must lie in [1, 4]");
   if (o.min_keypoints < 1 || o.min_keypoints > kMovenetKeypoints)
@@ -233,6 +234,7 @@ TopDownDetector::~TopDownDetector() = default;
 void TopDownDetector::reset() {
   followed_.clear();
   frame_ = 0;
+  last_detector_frame_ = 0;
   lost_someone_ = false;
   if (flow_) flow_->reset();
 }
@@ -441,8 +443,10 @@ std::vector<MovenetPerson> TopDownDetector::detect(const ImageBuffer& frame) {
     newcomer_.push_back(0);
     split_.push_back(0);
   }
+  const bool rerun_allowed = frame_ - last_detector_frame_ >= options_.rerun_gap;
   const bool run_detector =
-      frame_ % options_.detect_every == 0 || lost_someone_ || followed_.empty();
+      frame_ % options_.detect_every == 0 || (lost_someone_ && rerun_allowed) || followed_.empty();
+  if (run_detector) last_detector_frame_ = frame_;
   trace_.detector_ran = run_detector;
   trace_.detections.clear();
   trace_.taken_for.clear();
@@ -555,7 +559,8 @@ std::vector<MovenetPerson> TopDownDetector::detect(const ImageBuffer& frame) {
     }
     next.push_back(f);
   }
-  lost_someone_ = next.size() < followed_.size() && !run_detector;
+  // A loss whose re-run had to wait stays pending until the detector runs.
+  lost_someone_ = (lost_someone_ || next.size() < followed_.size()) && !run_detector;
   followed_ = std::move(next);
   ++profile_.frames;
   profile_.crops += static_cast<long long>(boxes.size());
