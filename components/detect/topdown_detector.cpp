@@ -28,6 +28,7 @@ double seconds_since(Clock::time_point start) {
 
 void check(const TopDownOptions& o) {
   if (o.detect_every < 1) throw std::invalid_argument("detect_every must be at least 1");
+  if (o.rerun_gap < 0) throw std::invalid_argument("rerun_gap must be >= 0");
   if (!(o.crop_padding >= 1.0f && o.crop_padding <= 4.0f))
     throw std::invalid_argument("crop_padding must lie in [1, 4]");
   if (o.min_keypoints < 1 || o.min_keypoints > kMovenetKeypoints)
@@ -258,6 +259,7 @@ void TopDownDetector::reset() {
   followed_.clear();
   frame_ = 0;
   detector_started_ = 0;
+  last_detector_frame_ = 0;
   detector_frame_people_.clear();
   lost_someone_ = false;
   if (flow_) flow_->reset();
@@ -642,7 +644,9 @@ std::vector<MovenetPerson> TopDownDetector::detect(const ImageBuffer& frame) {
       detector_started_ = frame_;
     }
   }
-  const bool due = frame_ % options_.detect_every == 0 || lost_someone_ || followed_.empty();
+  const bool rerun_allowed = frame_ - last_detector_frame_ >= options_.rerun_gap;
+  const bool due =
+      frame_ % options_.detect_every == 0 || (lost_someone_ && rerun_allowed) || followed_.empty();
   trace_.detections.clear();
   trace_.taken_for.clear();
   regions_.clear();
@@ -653,6 +657,7 @@ std::vector<MovenetPerson> TopDownDetector::detect(const ImageBuffer& frame) {
   const bool detector_ran = background ? finished_detector(detections) : due;
   if (detector_ran && !background) cropped = find_boxes_beside_crops(frame, boxes, detections);
   trace_.detector_ran = detector_ran;
+  if (detector_ran) last_detector_frame_ = frame_;
   if (detector_ran) take_detections(detections, boxes.size(), found, boxes);
   add_crops(frame, std::span<const Box2D>(boxes).subspan(cropped), static_cast<int>(poses_.size()));
   people_found(frame, found);
@@ -673,9 +678,12 @@ std::vector<MovenetPerson> TopDownDetector::detect(const ImageBuffer& frame) {
     record_crops(found, why);
   }
   std::vector<Followed> next = follow(people, found, kept);
-  // In the background a loss waits for the run going on to end (its boxes were taken before it).
+  // A loss waits to be looked for: in the background until a run starts after it (the run going
+  // on took its boxes before it), otherwise until the detector runs (rerun_gap frames after its
+  // last run at the soonest).
+  const bool lost_now = next.size() < followed_.size() && !detector_ran;
   lost_someone_ =
-      (background && lost_someone_) || (next.size() < followed_.size() && !detector_ran);
+      background ? lost_someone_ || lost_now : (lost_someone_ || lost_now) && !detector_ran;
   followed_ = std::move(next);
   ++frame_;
   // In the background a run starts when none is going on, detect_every frames after the last

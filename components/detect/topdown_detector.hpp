@@ -39,6 +39,9 @@ struct TopDownOptions {
   // The person detector runs on frame 0, then every detect_every frames (1: every frame), and on
   // the frame after one that lost somebody.
   int detect_every = 10;
+  // A re-run after a loss only when the detector last ran at least this many frames before (the
+  // loss waits for it or for the scheduled run); 0: every loss, as before (file-cpu).
+  int rerun_gap = 0;
   float min_box_score = 0.3f;  // CenterNet person score
   float box_overlap = 0.5f;    // detector boxes overlapping more are one (NMS)
   // The person detector on the whole frame stretched (1) or on this many square tiles of a wide
@@ -353,7 +356,8 @@ class TopDownDetector {
   std::vector<float> flow_limit_, flow_dx_, flow_dy_;
   std::vector<std::uint8_t> flow_ok_, carried_;
   long long frame_ = 0;
-  long long detector_started_ = 0;  // the frame its last background run started on
+  long long detector_started_ = 0;     // the frame its last background run started on
+  long long last_detector_frame_ = 0;  // the last frame the detector ran on (rerun_gap)
   long long next_id_ = 0;
   // The people followed on the frame the background run looks at: their ids and boxes.
   std::vector<std::pair<long long, Box2D>> detector_frame_people_;

@@ -196,8 +196,11 @@ struct Mp4Writer::Impl {
       c.flags |= AV_CODEC_FLAG_QSCALE;
       c.global_quality = FF_QP2LAMBDA * 4;
     }
+    // libx264 checks the preset only here: name it, the likeliest wrong setting.
     if (const int r = avcodec_open2(&c, codec, nullptr); r < 0)
-      fail(std::string("cannot open the ") + codec->name + " encoder", r);
+      fail(std::string("cannot open the ") + codec->name + " encoder" +
+               (codec->id == AV_CODEC_ID_H264 ? " (preset '" + options.h264_preset + "')" : ""),
+           r);
   }
 
   void open() {

@@ -78,8 +78,11 @@ void OverlayOutput::write(const ImageBuffer& picture, std::int64_t frame) {
     o.height = picture.height();
     // The file is made only now: a run that fails before its first picture leaves an existing
     // video as it was.
-    if (!o.options.video.empty())
-      o.video.emplace(o.options.video, o.width, o.height, video::Mp4WriterOptions{o.options.fps});
+    if (!o.options.video.empty()) {
+      video::Mp4WriterOptions writer{o.options.fps};
+      writer.h264_preset = o.options.h264_preset;
+      o.video.emplace(o.options.video, o.width, o.height, writer);
+    }
   }
   if (picture.width() != o.width || picture.height() != o.height) {
     throw std::invalid_argument("overlay output: picture size changed during the run");

@@ -617,6 +617,45 @@ TEST(TopDownDetector, TwoWorkersAndSmallPassesFindTheDefaultsPeopleToATenThousan
   EXPECT_EQ(profile[0].crops, profile[1].crops);
 }
 
+// The frame with its right half grey: whoever was followed there is lost.
+ImageBuffer right_half_grey() {
+  cv::Mat frame = cv::imread(kFrame.string());
+  frame(cv::Rect(frame.cols / 2, 0, frame.cols - frame.cols / 2, frame.rows)).setTo(128);
+  return test::image_of(frame);
+}
+
+// Which of frames 0..5 ran the person detector: frame 0 whole, then the right half grey, which
+// loses somebody on frame 1.
+std::vector<bool> detector_runs_after_a_loss(const Models& m, int rerun_gap) {
+  TopDownOptions o;
+  o.rerun_gap = rerun_gap;
+  TopDownDetector detector(o, m.lightning, m.centernet);
+  std::vector<bool> ran;
+  const auto whole = detector.detect(shifted_frame(0));
+  ran.push_back(detector.trace().detector_ran);
+  for (int i = 1; i < 6; ++i) {
+    const auto people = detector.detect(right_half_grey());
+    if (i == 1) {
+      EXPECT_LT(people.size(), whole.size()) << "nobody lost on frame 1";
+    }
+    ran.push_back(detector.trace().detector_ran);
+  }
+  return ran;
+}
+
+TEST(TopDownDetector, ARerunAfterALossWaitsForTheGap) {
+  std::string why;
+  const auto m = models(why);
+  if (!m) GTEST_SKIP() << why;
+  EXPECT_EQ(detector_runs_after_a_loss(*m, 0),
+            (std::vector<bool>{true, false, true, false, false, false}));
+  EXPECT_EQ(detector_runs_after_a_loss(*m, 5),
+            (std::vector<bool>{true, false, false, false, false, true}));
+  TopDownOptions o;
+  o.rerun_gap = -1;
+  EXPECT_THROW(TopDownDetector(o, m->lightning, m->centernet), std::invalid_argument);
+}
+
 TEST(TopDownDetector, WorkersAndPassesOutsideTheRangeAreRefused) {
   std::string why;
   const auto m = models(why);

@@ -9,6 +9,7 @@
 
 #include "core/input_error.hpp"
 #include "support/files.hpp"
+#include "video/mp4_writer.hpp"
 #include "viz/overlay_output.hpp"
 
 namespace mocap::viz {
@@ -46,6 +47,28 @@ TEST(OverlayOutput, EveryPictureIsAFrameAndPngsAsAskedFor) {
     EXPECT_NEAR(cv::mean(frame)[0], 4 * frames, 3.0) << "frame " << frames;
   }
   EXPECT_EQ(frames, 31);
+}
+
+// The preset reaches libx264: a name it does not know stops the first write, naming the file.
+TEST(OverlayOutput, TheH264PresetReachesTheEncoder) {
+  if (!video::h264_available()) GTEST_SKIP() << "this FFmpeg has no libx264";
+  test::TempDir dir;
+  OverlayOutputOptions fast{dir.file("fast.mp4"), 10.0, 0, ""};
+  fast.h264_preset = "ultrafast";
+  OverlayOutput written(fast);
+  written.write(grey_picture(100), 0);
+  written.close();
+  EXPECT_TRUE(cv::VideoCapture(fast.video, cv::CAP_FFMPEG).isOpened());
+  OverlayOutputOptions unknown{dir.file("unknown.mp4"), 10.0, 0, ""};
+  unknown.h264_preset = "no-such-preset";
+  OverlayOutput output(unknown);
+  try {
+    output.write(grey_picture(100), 0);
+    FAIL() << "an unknown preset was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("unknown.mp4"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("no-such-preset"), std::string::npos) << e.what();
+  }
 }
 
 TEST(OverlayOutput, AFailedWriteNamesTheFile) {

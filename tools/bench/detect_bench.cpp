@@ -103,7 +103,7 @@ Strategy make_strategy(const std::string& spec, detect::Backend backend, int thr
       o.pose_model = detect::parse_pose_model(parts[1]);
     } catch (const std::invalid_argument&) {
       throw std::invalid_argument(
-          "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:kEVERY][:uSURE][:"
+          "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:kEVERY][:eGAP][:uSURE][:"
           "bPRESENCE][:m0][:h1][:cH[xP]][:aIOU][:oOKS][:n1][:x1][:r1][:g1][:p0] with "
           "MODEL " +
           std::string(detect::pose_model_names()) + ", got " + spec);
@@ -152,12 +152,14 @@ Strategy make_strategy(const std::string& spec, detect::Backend backend, int thr
         if (hp.size() > 1) o.small_crop_padding = std::stof(hp[1]);
       } else if (parts[i].size() > 1 && parts[i][0] == 'k')
         o.keypoint_every = std::stoi(parts[i].substr(1));
+      else if (parts[i].size() > 1 && parts[i][0] == 'e')
+        o.rerun_gap = std::stoi(parts[i].substr(1));
       else
         numbers.push_back(parts[i]);
     }
     if (numbers.size() > 2)
       throw std::invalid_argument(
-          "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:kEVERY][:uSURE][:"
+          "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:kEVERY][:eGAP][:uSURE][:"
           "bPRESENCE][:m0][:h1][:cH[xP]][:aIOU][:oOKS][:n1][:x1][:r1][:g1][:p0], got " +
           spec);
     o.backend = backend;
@@ -174,11 +176,11 @@ Strategy make_strategy(const std::string& spec, detect::Backend backend, int thr
             o,
             [d] { return d->trace(); }};
   }
-  throw std::invalid_argument(
-      "unknown strategy '" + spec +
-      "' (multipose:SIZE, tiles:CxR:TILE:FRAME, "
-      "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:"
-      "kEVERY][:uSURE][:bPRESENCE][:m0][:h1][:cH[xP]][:aIOU][:oOKS][:n1][:x1][:r1][:g1][:p0])");
+  throw std::invalid_argument("unknown strategy '" + spec +
+                              "' (multipose:SIZE, tiles:CxR:TILE:FRAME, "
+                              "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:"
+                              "kEVERY][:eGAP][:uSURE][:bPRESENCE][:m0][:h1][:cH[xP]][:aIOU][:oOKS]["
+                              ":n1][:x1][:r1][:g1][:p0])");
 }
 
 // Every frame of a video, or the one image of a still.
@@ -679,7 +681,7 @@ int main(int argc, char** argv) {
           "the first (on the first runtime) is the reference for keypoint distances: "
           "multipose:SIZE, "
           "tiles:CxR:TILE:FRAME, "
-          "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:kEVERY][:"
+          "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:kEVERY][:eGAP][:"
           "uSURE][:bPRESENCE][:m0][:h1][:cH[xP]][:aIOU][:oOKS][:n1][:x1][:r1][:g1][:p0] "
           "(MODEL: lightning, thunder, blazepose-lite, blazepose-full, blazepose-heavy; "
           "workers: copies of the keypoint network sharing a frame's crops; tTILES: person "
@@ -695,7 +697,8 @@ int main(int argc, char** argv) {
           "detector box (others overlapping them get crops), "
           "x1: a followed box over 2+ detector boxes is split into them, "
           "r1: CenterNet sees the frame at its aspect "
-          "(512 x 896 for 16:9) instead of squeezed to 512 x 512, kEVERY: keypoint pass every "
+          "(512 x 896 for 16:9) instead of squeezed to 512 x 512, eGAP: a detector re-run after a "
+          "loss only GAP frames after its last run, kEVERY: keypoint pass every "
           "EVERY "
           "frames, optical flow between, g1: the person detector in the background (no frame "
           "waits for it; live), p0: keypoint passes not spread over the frames between; a top-down "

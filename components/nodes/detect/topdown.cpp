@@ -83,6 +83,10 @@ class TopDownNode : public Node {
                  "crops per forward pass of the keypoint network at most (1, 2, 4 or 8); the "
                  "people found do not depend on it, the time does (2: measured fastest)",
                  {1, 8});
+    c.param<int>("rerun_gap", 0,
+                 "a detector re-run after a loss only this many frames after its last run (the "
+                 "loss waits); 0: at every loss",
+                 {0, 1000});
     c.param<int>("keypoint_every", 1,
                  "live: a person's keypoint pass every N frames, carried by optical flow between "
                  "(a person whose flow fails gets a pass at once); 1: every frame",
@@ -123,6 +127,7 @@ class TopDownNode : public Node {
     o.threads = network.threads;
     o.workers = ctx.param<int>("workers");
     o.keypoint_every = ctx.param<int>("keypoint_every");
+    o.rerun_gap = ctx.param<int>("rerun_gap");
     o.crops_per_pass = ctx.param<int>("crops_per_pass");
     o.detector_in_background = ctx.param<bool>("detector_in_background");
     detector_.emplace(o, model_file(ctx, "pose_model_file", detect::model_name(o.pose_model)),

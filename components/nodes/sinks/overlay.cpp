@@ -35,6 +35,8 @@ class OverlaySink : public Node {
                          "MP4 file to write (fragmented, H.264: plays even if the run is killed); "
                          "empty: none");
     c.param<double>("fps", 30.0, "frame rate of the MP4", {0.1, 1000.0});
+    c.param<std::string>("h264_preset", "superfast",
+                         "libx264 preset of the MP4 (ultrafast: less CPU, larger file)");
     c.param<std::int64_t>("png_every", 0, "a PNG of every Nth drawn frame; 0: none", {0, 1e9});
     c.param<std::string>("png_dir", "", "folder for the PNGs (overlay_<frame>.png)");
     c.param<std::int64_t>("canvas_width", 1920, "2D input's pixel space (its video's size)",
@@ -55,6 +57,7 @@ class OverlaySink : public Node {
     viz::OverlayOutputOptions out;
     out.video = ctx.param<std::string>("video");
     out.fps = ctx.param<double>("fps");
+    out.h264_preset = ctx.param<std::string>("h264_preset");
     out.png_every = ctx.param<int>("png_every");
     out.png_dir = ctx.param<std::string>("png_dir");
     if (out.video.empty() && out.png_every == 0)
