@@ -51,6 +51,11 @@ using nlohmann::json;
 using Clock = std::chrono::steady_clock;
 using People = std::vector<detect::MovenetPerson>;
 
+// The grammar of a top-down strategy, for the errors and --help.
+constexpr const char* kTopdownSpec =
+    "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:kEVERY][:eGAP][:uSURE][:"
+    "bPRESENCE][:m0][:h1][:cH[xP]][:aIOU][:oOKS][:n1][:x1][:r1][:g1][:p0]";
+
 struct Strategy {
   std::string name;
   std::function<People(const ImageBuffer&)> detect;
@@ -102,11 +107,8 @@ Strategy make_strategy(const std::string& spec, detect::Backend backend, int thr
     try {
       o.pose_model = detect::parse_pose_model(parts[1]);
     } catch (const std::invalid_argument&) {
-      throw std::invalid_argument(
-          "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:kEVERY][:eGAP][:uSURE][:"
-          "bPRESENCE][:m0][:h1][:cH[xP]][:aIOU][:oOKS][:n1][:x1][:r1][:g1][:p0] with "
-          "MODEL " +
-          std::string(detect::pose_model_names()) + ", got " + spec);
+      throw std::invalid_argument(std::string(kTopdownSpec) + " with MODEL " +
+                                  std::string(detect::pose_model_names()) + ", got " + spec);
     }
     o.detect_every = std::stoi(parts[2]);
     // Then WORKERS and THREADS, and anywhere tN (person detector on N tiles; tNw: and the whole
@@ -158,10 +160,7 @@ Strategy make_strategy(const std::string& spec, detect::Backend backend, int thr
         numbers.push_back(parts[i]);
     }
     if (numbers.size() > 2)
-      throw std::invalid_argument(
-          "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:kEVERY][:eGAP][:uSURE][:"
-          "bPRESENCE][:m0][:h1][:cH[xP]][:aIOU][:oOKS][:n1][:x1][:r1][:g1][:p0], got " +
-          spec);
+      throw std::invalid_argument(std::string(kTopdownSpec) + ", got " + spec);
     o.backend = backend;
     o.threads = numbers.size() == 2 ? std::stoi(numbers[1]) : threads;
     o.workers = numbers.empty() ? 1 : std::stoi(numbers[0]);
@@ -177,10 +176,7 @@ Strategy make_strategy(const std::string& spec, detect::Backend backend, int thr
             [d] { return d->trace(); }};
   }
   throw std::invalid_argument("unknown strategy '" + spec +
-                              "' (multipose:SIZE, tiles:CxR:TILE:FRAME, "
-                              "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:"
-                              "kEVERY][:eGAP][:uSURE][:bPRESENCE][:m0][:h1][:cH[xP]][:aIOU][:oOKS]["
-                              ":n1][:x1][:r1][:g1][:p0])");
+                              "' (multipose:SIZE, tiles:CxR:TILE:FRAME, " + kTopdownSpec + ")");
 }
 
 // Every frame of a video, or the one image of a still.
@@ -680,29 +676,33 @@ int main(int argc, char** argv) {
           "strategies", "LIST",
           "the first (on the first runtime) is the reference for keypoint distances: "
           "multipose:SIZE, "
-          "tiles:CxR:TILE:FRAME, "
-          "topdown:MODEL:EVERY[:WORKERS[:THREADS]][:tTILES[w]][:sSCORE][:kEVERY][:eGAP][:"
-          "uSURE][:bPRESENCE][:m0][:h1][:cH[xP]][:aIOU][:oOKS][:n1][:x1][:r1][:g1][:p0] "
-          "(MODEL: lightning, thunder, blazepose-lite, blazepose-full, blazepose-heavy; "
-          "workers: copies of the keypoint network sharing a frame's crops; tTILES: person "
-          "detector tiles, tTILESw: and the whole frame, sSCORE: its box score floor, uSURE: "
-          "boxes scoring SURE are people whatever their keypoints, bPRESENCE: BlazePose "
-          "boxes from the landmarks of this presence (default 0.5; above 1: from the kept "
-          "keypoints), m0: that landmark box widened as the keypoints' and not cut to the "
-          "picture (before the anatomical margins), h1: BlazePose's head margin at least 0.54 x "
-          "the eyes' height above the shoulders, cH[xP]: boxes under H px get crops of "
-          "padding P (default 1.5), aIOU: a newcomer is a person only when its posed box overlaps "
-          "the detector's by this IoU, oOKS: finds sharing 3 keypoints are one person only at this "
-          "keypoint similarity (COCO OKS; 0.9: HRNet's), n1: a followed person is at most one "
-          "detector box (others overlapping them get crops), "
-          "x1: a followed box over 2+ detector boxes is split into them, "
-          "r1: CenterNet sees the frame at its aspect "
-          "(512 x 896 for 16:9) instead of squeezed to 512 x 512, eGAP: a detector re-run after a "
-          "loss only GAP frames after its last run, kEVERY: keypoint pass every "
-          "EVERY "
-          "frames, optical flow between, g1: the person detector in the background (no frame "
-          "waits for it; live), p0: keypoint passes not spread over the frames between; a top-down "
-          "strategy also prints where its time went)",
+          "tiles:CxR:TILE:FRAME, " +
+              std::string(kTopdownSpec) +
+              " (MODEL: lightning, thunder, blazepose-lite, blazepose-full, blazepose-heavy; "
+              "workers: copies of the keypoint network sharing a frame's crops; tTILES: person "
+              "detector tiles, tTILESw: and the whole frame, sSCORE: its box score floor, uSURE: "
+              "boxes scoring SURE are people whatever their keypoints, bPRESENCE: BlazePose "
+              "boxes from the landmarks of this presence (default 0.5; above 1: from the kept "
+              "keypoints), m0: that landmark box widened as the keypoints' and not cut to the "
+              "picture (before the anatomical margins), h1: BlazePose's head margin at least 0.54 "
+              "x "
+              "the eyes' height above the shoulders, cH[xP]: boxes under H px get crops of "
+              "padding P (default 1.5), aIOU: a newcomer is a person only when its posed box "
+              "overlaps "
+              "the detector's by this IoU, oOKS: finds sharing 3 keypoints are one person only at "
+              "this "
+              "keypoint similarity (COCO OKS; 0.9: HRNet's), n1: a followed person is at most one "
+              "detector box (others overlapping them get crops), "
+              "x1: a followed box over 2+ detector boxes is split into them, "
+              "r1: CenterNet sees the frame at its aspect "
+              "(512 x 896 for 16:9) instead of squeezed to 512 x 512, eGAP: a detector re-run "
+              "after a "
+              "loss only GAP frames after its last run, kEVERY: keypoint pass every "
+              "EVERY "
+              "frames, optical flow between, g1: the person detector in the background (no frame "
+              "waits for it; live), p0: keypoint passes not spread over the frames between; a "
+              "top-down "
+              "strategy also prints where its time went)",
           "topdown:thunder:1,multipose:256,multipose:512,tiles:2x2:256:256,"
           "topdown:lightning:1,topdown:lightning:10,topdown:thunder:10")
       .option("truth", "DIR", "hand-checked boxes", "tests/data/detection")
