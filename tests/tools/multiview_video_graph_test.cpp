@@ -24,9 +24,9 @@ TEST(MultiViewVideoGraph, RunsWithCompleteSetsAndWholeOutput) {
   MOCAP_REQUIRE_SHARED(video);
   MOCAP_REQUIRE_SHARED(demo_rig);
   try {
-    detect::cached_model_json("movenet-lightning");
+    detect::cached_model_json("blazepose-full");
   } catch (const detect::ModelMissing&) {
-    GTEST_SKIP() << "MoveNet Lightning absent: tools/setup.sh --models-only";
+    GTEST_SKIP() << "BlazePose full absent: tools/setup.sh --models-only";
   }
   TempDir dir;
   std::string rig = read_file((shared_data() / demo_rig).string());

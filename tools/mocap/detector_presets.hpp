@@ -30,7 +30,8 @@ const DetectorPreset& detector_preset(std::string_view name);
 // MultiPose's 0.6 at 24.5-25; 2026-11-26).
 // Several live cameras keep MultiPose: each view runs its own detector on the same 2 cores, and
 // the multi-camera live runs were measured with it (topdown-live was not). Each is a one-line
-// change.
+// change here; the graphs in graphs/ carry the same detectors, which
+// tests/tools/shipped_graphs_test.cpp checks.
 inline constexpr std::string_view kFileDetector = "topdown-blaze";
 inline constexpr std::string_view kLiveDetector = "topdown-live";
 inline constexpr std::string_view kLiveMultiviewDetector = "multipose";
