@@ -21,13 +21,16 @@ namespace mocap::video {
 
 enum class Mp4Codec { automatic, h264, mpeg4 };
 
+// libx264's speed/size trade-off: ultrafast, superfast, veryfast, faster, fast, medium, ...
+// superfast: docs/overlay.md, "Cost" (ultrafast saves little CPU for a much larger file).
+inline constexpr std::string_view kDefaultH264Preset = "superfast";
+
 struct Mp4WriterOptions {
   double fps = 30.0;                     // frame rate (frames are evenly spaced)
   Mp4Codec codec = Mp4Codec::automatic;  // automatic: H.264 when libx264 is there, else MPEG-4
   int keyframe_interval = 0;  // frames from one keyframe to the next (seeking); 0: one second
   int threads = 1;            // encoder threads (0: FFmpeg's choice, one per core)
-  // libx264's speed/size trade-off: ultrafast, superfast, veryfast, faster, fast, medium, ...
-  std::string h264_preset = "superfast";
+  std::string h264_preset{kDefaultH264Preset};
 };
 
 // Whether this FFmpeg can encode H.264 (its libx264 encoder).

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "core/image_buffer.hpp"
+#include "video/mp4_writer.hpp"
 
 namespace mocap::viz {
 
@@ -16,7 +17,7 @@ struct OverlayOutputOptions {
   double fps = 30.0;    // the video's frame rate
   int png_every = 0;    // a PNG of every Nth picture (the first included); 0: none
   std::string png_dir;  // where the PNGs go (created when missing): overlay_<frame>.png
-  std::string h264_preset = "superfast";  // libx264 preset of the MP4 (docs/overlay.md, Cost)
+  std::string h264_preset{video::kDefaultH264Preset};  // libx264 preset of the MP4
 };
 
 class OverlayOutput {

@@ -12,6 +12,7 @@
 
 #include "graph/registry.hpp"
 #include "video/frame_reader.hpp"
+#include "video/mp4_writer.hpp"
 #include "viz/overlay_output.hpp"
 #include "viz/overlay_renderer.hpp"
 
@@ -35,7 +36,7 @@ class OverlaySink : public Node {
                          "MP4 file to write (fragmented, H.264: plays even if the run is killed); "
                          "empty: none");
     c.param<double>("fps", 30.0, "frame rate of the MP4", {0.1, 1000.0});
-    c.param<std::string>("h264_preset", "superfast",
+    c.param<std::string>("h264_preset", std::string(video::kDefaultH264Preset),
                          "libx264 preset of the MP4 (ultrafast: less CPU, larger file)");
     c.param<std::int64_t>("png_every", 0, "a PNG of every Nth drawn frame; 0: none", {0, 1e9});
     c.param<std::string>("png_dir", "", "folder for the PNGs (overlay_<frame>.png)");
