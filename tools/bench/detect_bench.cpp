@@ -672,39 +672,32 @@ int main(int argc, char** argv) {
               "../shared/data/eval/openpose_examples_media/COCO_val2014_000000000241.jpg,"
               "../shared/data/eval/openpose_examples_media/COCO_val2014_000000000328.jpg,"
               "../shared/data/eval/openpose_examples_media/COCO_val2014_000000000536.jpg")
-      .option(
-          "strategies", "LIST",
-          "the first (on the first runtime) is the reference for keypoint distances: "
-          "multipose:SIZE, "
-          "tiles:CxR:TILE:FRAME, " +
-              std::string(kTopdownSpec) +
-              " (MODEL: lightning, thunder, blazepose-lite, blazepose-full, blazepose-heavy; "
-              "workers: copies of the keypoint network sharing a frame's crops; tTILES: person "
-              "detector tiles, tTILESw: and the whole frame, sSCORE: its box score floor, uSURE: "
-              "boxes scoring SURE are people whatever their keypoints, bPRESENCE: BlazePose "
-              "boxes from the landmarks of this presence (default 0.5; above 1: from the kept "
-              "keypoints), m0: that landmark box widened as the keypoints' and not cut to the "
-              "picture (before the anatomical margins), h1: BlazePose's head margin at least 0.54 "
-              "x "
-              "the eyes' height above the shoulders, cH[xP]: boxes under H px get crops of "
-              "padding P (default 1.5), aIOU: a newcomer is a person only when its posed box "
-              "overlaps "
-              "the detector's by this IoU, oOKS: finds sharing 3 keypoints are one person only at "
-              "this "
-              "keypoint similarity (COCO OKS; 0.9: HRNet's), n1: a followed person is at most one "
-              "detector box (others overlapping them get crops), "
-              "x1: a followed box over 2+ detector boxes is split into them, "
-              "r1: CenterNet sees the frame at its aspect "
-              "(512 x 896 for 16:9) instead of squeezed to 512 x 512, eGAP: a detector re-run "
-              "after a "
-              "loss only GAP frames after its last run, kEVERY: keypoint pass every "
-              "EVERY "
-              "frames, optical flow between, g1: the person detector in the background (no frame "
-              "waits for it; live), p0: keypoint passes not spread over the frames between; a "
-              "top-down "
-              "strategy also prints where its time went)",
-          "topdown:thunder:1,multipose:256,multipose:512,tiles:2x2:256:256,"
-          "topdown:lightning:1,topdown:lightning:10,topdown:thunder:10")
+      .option("strategies", "LIST",
+              "the first (on the first runtime) is the reference for keypoint distances: "
+              "multipose:SIZE, "
+              "tiles:CxR:TILE:FRAME, " +
+                  std::string(kTopdownSpec) +
+                  " (MODEL: lightning, thunder, blazepose-lite, blazepose-full, blazepose-heavy; "
+                  "workers: copies of the keypoint network sharing a frame's crops; tTILES: "
+                  "person detector tiles, tTILESw: and the whole frame, sSCORE: its box score "
+                  "floor, uSURE: boxes scoring SURE are people whatever their keypoints, "
+                  "bPRESENCE: BlazePose boxes from the landmarks of this presence (default 0.5; "
+                  "above 1: from the kept keypoints), m0: that landmark box widened as the "
+                  "keypoints' and not cut to the picture (before the anatomical margins), h1: "
+                  "BlazePose's head margin at least 0.54 x the eyes' height above the shoulders, "
+                  "cH[xP]: boxes under H px get crops of padding P (default 1.5), aIOU: a "
+                  "newcomer is a person only when its posed box overlaps the detector's by this "
+                  "IoU, oOKS: finds sharing 3 keypoints are one person only at this keypoint "
+                  "similarity (COCO OKS; 0.9: HRNet's), n1: a followed person is at most one "
+                  "detector box (others overlapping them get crops), x1: a followed box over 2+ "
+                  "detector boxes is split into them, r1: CenterNet sees the frame at its aspect "
+                  "(512 x 896 for 16:9) instead of squeezed to 512 x 512, eGAP: a detector "
+                  "re-run after a loss only GAP frames after its last run, kEVERY: keypoint pass "
+                  "every EVERY frames, optical flow between, g1: the person detector in the "
+                  "background (no frame waits for it; live), p0: keypoint passes not spread over "
+                  "the frames between; a top-down strategy also prints where its time went)",
+              "topdown:thunder:1,multipose:256,multipose:512,tiles:2x2:256:256,"
+              "topdown:lightning:1,topdown:lightning:10,topdown:thunder:10")
       .option("truth", "DIR", "hand-checked boxes", "tests/data/detection")
       .option("iou", "X", "a detection matches a true box at this IoU", "0.5")
       .option("backends", "LIST",
